@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Quick start, step 1: install dependencies, build (Release) and render the default
+# example to build/example.png with a per-stage timing table.
+source "$(dirname "$0")/scripts/common.sh"
+sslpv_install_packages
+sslpv_build
+"$SSLPV_BUILD/sslpv" render "$SSLPV_ROOT/examples/marble_pebble.json" \
+  -o "$SSLPV_BUILD/example.png" --backend cpu --timings
+echo "sslpv: wrote $SSLPV_BUILD/example.png"

@@ -1,0 +1,41 @@
+#pragma once
+// Helpers shared by the test binaries: a private temporary directory per test (tests
+// run in parallel under ctest -j) and running the sslpv binary as a user would.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace sslpv::test {
+
+/// A fresh directory, removed when the object goes away.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+void writeText(const std::filesystem::path& file, const std::string& text);
+std::string readText(const std::filesystem::path& file);
+
+struct RunResult {
+  int exitCode = -1;       ///< -1 when killed by a signal
+  int signal = 0;          ///< the signal number when killed
+  std::string stdoutText;
+  std::string stderrText;
+};
+
+/// Runs the built sslpv binary with `args` (no shell), capturing its output.
+RunResult runSslpv(const std::vector<std::string>& args);
+
+/// The repository root and the example folder.
+std::filesystem::path sourceDir();
+std::filesystem::path examplesDir();
+
+}  // namespace sslpv::test

@@ -1,0 +1,33 @@
+// Constants of the L1 spherical-harmonic light propagation volume, shared verbatim by
+// the C++ backend and the GLSL shaders (plain #defines: valid C++ and GLSL).
+//
+// SH convention: coefficient order (Y00, Y1x, Y1y, Y1z); a direction w evaluates
+// as  c0*Y00 + Y1*(c1x*w.x + c1y*w.y + c1z*w.z).
+#ifndef SSLPV_LPV_CONSTANTS_H
+#define SSLPV_LPV_CONSTANTS_H
+
+#define SSLPV_SH_Y00 0.28209479177387814
+#define SSLPV_SH_Y1 0.4886025119029199
+
+// Clamped cosine lobe max(0, n.w) projected to L1: (sqrt(pi)/2, sqrt(pi/3) n).
+#define SSLPV_COSINE_LOBE_C0 0.8862269254527579
+#define SSLPV_COSINE_LOBE_C1 1.0233267079464885
+
+// Integrals over the hemisphere around n: of Y00 is sqrt(pi), of Y1m is
+// (sqrt(3 pi)/2) n_m. Used to turn a cell's intensity into radiance at a surface.
+#define SSLPV_HEMI_Y00 1.7724538509055159
+#define SSLPV_HEMI_Y1 1.5349900619197328
+
+// Solid angles of a destination cell's faces seen from the source cell centre
+// (Kaplanyan-Dachsbacher): the face opposite the source, and each of the four side
+// faces. 4*side + front = 2*pi/3 exactly. (0.4234413544, seen in many LPV shaders,
+// is a typo.)
+#define SSLPV_FRONT_FACE_SOLID_ANGLE 0.4006696846462392
+#define SSLPV_SIDE_FACE_SOLID_ANGLE 0.4234313544367392
+
+// Total flux of a cell whose DC coefficient is c0: integral of c0*Y00 over the sphere.
+#define SSLPV_FLUX_PER_C0 3.5449077018110318
+
+#define SSLPV_PI 3.14159265358979323846
+
+#endif

@@ -1,0 +1,65 @@
+#pragma once
+// The dense LPV grids: a world-axis-aligned frame of cubic cells around the object,
+// the material resampled into it, and the L1 SH light field (12 planes, SoA, x fastest).
+#include <array>
+#include <cstddef>
+#include <glm/vec3.hpp>
+#include <vector>
+
+namespace sslpv {
+
+struct Bounds;
+
+struct GridFrame {
+  glm::dvec3 origin{0.0};  ///< world position of the min corner of cell (0,0,0)
+  double cellSize = 1.0;   ///< world units
+  glm::ivec3 dims{0};
+
+  std::size_t cellCount() const { return std::size_t(dims.x) * dims.y * dims.z; }
+  /// x fastest, then y, then z.
+  std::size_t index(int x, int y, int z) const {
+    return (std::size_t(z) * dims.y + y) * dims.x + x;
+  }
+  bool contains(int x, int y, int z) const {
+    return x >= 0 && y >= 0 && z >= 0 && x < dims.x && y < dims.y && z < dims.z;
+  }
+  glm::dvec3 cellMin(int x, int y, int z) const {
+    return origin + cellSize * glm::dvec3(x, y, z);
+  }
+  glm::dvec3 cellCenter(int x, int y, int z) const {
+    return origin + cellSize * (glm::dvec3(x, y, z) + 0.5);
+  }
+  /// Continuous cell coordinates: cell (i,j,k) spans [i, i+1) on each axis.
+  glm::dvec3 toGrid(const glm::dvec3& world) const { return (world - origin) / cellSize; }
+};
+
+/// Frame whose longest axis holds `resolution` cubic cells and that covers `bounds`
+/// plus a margin of one cell on every side (so boundary cells always have neighbours
+/// outside the object). Throws ResourceError when the grids would not fit in memory.
+GridFrame makeGridFrame(const Bounds& objectBounds, int resolution);
+
+/// Bytes the CPU backend needs for a frame (material + three SH grids).
+std::size_t estimateLpvBytes(const GridFrame& frame);
+
+/// The material and occupancy of every LPV cell.
+struct MaterialGrid {
+  GridFrame frame;
+  std::vector<float> coverage;          ///< fraction of the cell inside the mesh, [0,1]
+  std::vector<glm::vec3> sigmaT;        ///< box-filtered over the cell, per scene unit
+  std::vector<glm::vec3> sigmaS;
+  std::vector<float> g;
+};
+
+/// L1 SH light field: coefficient plane c = channel*4 + sh (sh: 0 = Y00, 1..3 = Y1 x,y,z).
+struct ShGrid {
+  static constexpr int kPlanes = 12;
+  GridFrame frame;
+  std::array<std::vector<float>, kPlanes> planes;
+
+  void resize(const GridFrame& f);
+  void clear();
+  float* plane(int channel, int sh) { return planes[channel * 4 + sh].data(); }
+  const float* plane(int channel, int sh) const { return planes[channel * 4 + sh].data(); }
+};
+
+}  // namespace sslpv

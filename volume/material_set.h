@@ -1,0 +1,94 @@
+#pragma once
+// Material sets: OpenVDB files with sigma_t, sigma_s (Vec3SGrid) and g (FloatGrid), and
+// the one continuous material field every consumer samples (DESIGN.md "Material set").
+#include <openvdb/openvdb.h>
+
+#include <filesystem>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "volume/material.h"
+
+namespace sslpv {
+
+struct GridFrame;
+struct MaterialGrid;
+struct Bounds;
+
+struct MaterialSet {
+  openvdb::Vec3SGrid::Ptr sigmaT;  ///< required
+  openvdb::Vec3SGrid::Ptr sigmaS;  ///< required
+  openvdb::FloatGrid::Ptr g;       ///< optional: absent means the base material's g
+  std::string units = "mm";        ///< file metadata "units"
+  std::string creator;             ///< file metadata "creator"
+};
+
+/// One problem found in a material-set file: "file: grid 'sigma_s' voxel (3,4,5): ...".
+struct ValidationProblem {
+  std::string message;
+};
+
+/// Calls openvdb::initialize() once; every entry point below calls it.
+void initializeOpenVdb();
+
+/// Loads and validates; throws InputError with the first problem (file, grid, voxel).
+std::shared_ptr<const MaterialSet> loadMaterialSet(const std::filesystem::path& file);
+
+/// Every problem in `set` (σt < 0, σs < 0, σs > σt, |g| >= 1, NaN/Inf), each naming
+/// `fileForMessages`, the grid and the voxel. Stops after `maxProblems`.
+std::vector<ValidationProblem> validateMaterialSet(const MaterialSet& set,
+                                                   const std::string& fileForMessages,
+                                                   std::size_t maxProblems = 100);
+
+/// Writes the set atomically with metadata units/creator/version.
+void saveMaterialSet(const MaterialSet& set, const std::filesystem::path& file);
+
+/// Human-readable report for `sslpv inspect`: grids, types, active voxel counts, value
+/// ranges, transforms, metadata and every validation problem. Returns false when the
+/// file has problems (the report then lists them). Throws InputError when unreadable.
+bool inspectVdbFile(const std::filesystem::path& file, std::ostream& report);
+
+/// The continuous material field: trilinear between voxel centres (BoxSampler
+/// convention) of each grid through its own transform; inactive voxels and anything
+/// outside a grid take the base material's value. `worldToRest` maps world points into
+/// the grids' (object rest) space. `sigmaScale` multiplies the σ read from the grids to
+/// convert the file's units to the scene's (σ is intrinsic: scaling the object does not
+/// change it). Thread-safe: each thread makes its own Sampler.
+class MaterialField {
+ public:
+  MaterialField(const MaterialSample& base, std::shared_ptr<const MaterialSet> set,
+                const glm::dmat4& worldToRest, double sigmaScale);
+
+  class Sampler {
+   public:
+    /// The field at a world point.
+    MaterialSample sample(const glm::dvec3& world) const;
+    /// The field averaged over a world-axis-aligned box: exact for the trilinear field
+    /// when the grids are axis-aligned in world space, else a dense stratified average.
+    MaterialSample boxAverage(const glm::dvec3& worldMin, const glm::dvec3& worldMax) const;
+
+   private:
+    friend class MaterialField;
+    struct Impl;
+    std::shared_ptr<Impl> impl_;
+  };
+
+  Sampler sampler() const;
+  const MaterialSample& base() const { return base_; }
+  bool homogeneous() const { return !set_; }
+
+ private:
+  MaterialSample base_;
+  std::shared_ptr<const MaterialSet> set_;
+  glm::dmat4 worldToRest_;
+  double sigmaScale_;
+};
+
+/// Fills material.sigmaT/sigmaS/g for every cell of `material.frame` with the field
+/// box-filtered over the cell (TBB parallel). coverage is left as is.
+void resampleMaterial(const MaterialField& field, MaterialGrid& material);
+
+}  // namespace sslpv

@@ -1,0 +1,90 @@
+#pragma once
+// The scene contract (DESIGN.md): parsed strictly from JSON. Unknown keys, wrong types,
+// missing required keys and out-of-range values are InputErrors naming the key path,
+// e.g. "scene.json: lights[1].intensity: expected an array of 3 non-negative numbers".
+#include <filesystem>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "volume/material.h"
+
+namespace sslpv {
+
+struct MeshSource {
+  enum class Kind { File, Box, Sphere };
+  Kind kind = Kind::Box;
+  std::filesystem::path path;  ///< Kind::File: resolved against the scene file's folder
+  glm::dvec3 boxMin{-0.5}, boxMax{0.5};
+  glm::dvec3 center{0.0};
+  double radius = 0.5;
+};
+
+/// Similarity transform: scale, then rotate (X, then Y, then Z, degrees), then translate.
+struct Transform {
+  glm::dvec3 translate{0.0};
+  glm::dvec3 rotateDeg{0.0};
+  double scale = 1.0;
+  glm::dmat4 matrix() const;  ///< rest (object) space -> world space
+};
+
+struct MaterialSpec {
+  MaterialSample base;      ///< per scene unit
+  std::string presetName;   ///< empty when base was given as explicit sigmas
+  std::optional<std::filesystem::path> vdb;  ///< resolved against the scene file's folder
+  double ior = 1.0;         ///< 1.0 = index-matched boundary
+};
+
+struct Light {
+  enum class Type { Point, Spot, Directional };
+  Type type = Type::Point;
+  glm::dvec3 position{0.0};    ///< point, spot
+  glm::dvec3 direction{0.0, -1.0, 0.0};  ///< spot, directional: unit vector the light travels along
+  double fovDeg = 40.0;        ///< spot: full cone angle, hard edge, in (0, 180)
+  glm::vec3 intensity{0.0f};   ///< point, spot: W/sr per channel
+  glm::vec3 irradiance{0.0f};  ///< directional: W per scene-unit^2 on a surface facing it
+};
+
+struct Camera {
+  glm::dvec3 position{0.0, 0.0, 5.0};
+  glm::dvec3 target{0.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+  double fovYDeg = 35.0;
+  int width = 512;
+  int height = 512;
+};
+
+struct LpvSettings {
+  int resolution = 32;  ///< cells along the longest axis of the object's padded bounds
+  int steps = 8;        ///< propagation steps (ignored when autoSteps)
+  bool autoSteps = false;
+  int shadowMap = 256;  ///< shadow-map texels per side
+};
+
+struct Scene {
+  std::filesystem::path file;  ///< the JSON it came from (for messages)
+  std::string units = "mm";
+  double unitInMm = 1.0;
+  MeshSource mesh;
+  Transform transform;
+  MaterialSpec material;
+  std::vector<Light> lights;
+  Camera camera;
+  LpvSettings lpv;
+};
+
+/// Largest accepted lpv.resolution / --grid: beyond it the grids do not fit in memory.
+inline constexpr int kMaxLpvResolution = 512;
+inline constexpr int kMaxShadowMap = 8192;
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr int kMaxSteps = 1000000;
+
+/// Reads and validates a scene file. Throws InputError (file and key path in the message).
+Scene loadScene(const std::filesystem::path& file);
+
+/// Parses scene JSON text; `file` names it in messages and anchors relative paths.
+Scene parseScene(const std::string& jsonText, const std::filesystem::path& file);
+
+}  // namespace sslpv
