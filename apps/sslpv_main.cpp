@@ -1,1 +1,137 @@
-int main() { return 0; }
+// The `sslpv` command line: one binary, subcommands (DESIGN.md "Command line").
+// Exit codes: 0 success, 1 internal error, 2 bad input, 3 not enough resources.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <new>
+#include <optional>
+#include <string>
+
+#include "volume/atomic_file.h"
+#include "volume/cpu_renderer.h"
+#include "volume/error.h"
+#include "volume/image_io.h"
+#include "volume/material_set.h"
+#include "volume/scene.h"
+
+namespace {
+
+constexpr int kExitInternal = 1;
+constexpr int kExitInput = 2;
+constexpr int kExitResource = 3;
+
+int fail(int code, std::string message) {
+  for (char& c : message)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::cerr << "sslpv: error: " << message << std::endl;
+  return code;
+}
+
+struct RenderArgs {
+  std::string scene, output, backend = "cpu", steps;
+  std::optional<int> grid, shadowMap;
+  bool timings = false;
+  float exposure = 1.0f;
+};
+
+int runRender(const RenderArgs& args) {
+  using namespace sslpv;
+  if (args.backend == "vulkan")
+    throw InputError("--backend vulkan: the Vulkan backend is not built yet; use --backend cpu");
+  if (args.backend != "cpu") throw InputError("--backend: unknown backend '" + args.backend + "' (cpu, vulkan)");
+  if (!isSupportedImageExtension(args.output))
+    throw InputError(args.output + ": unsupported output format (use .png, .pfm or .exr)");
+  requireWritableOutput(args.output);
+
+  Scene scene = loadScene(args.scene);
+  LpvSettings settings = scene.lpv;
+  if (args.grid) {
+    if (*args.grid < 2 || *args.grid > kMaxLpvResolution)
+      throw InputError("--grid: must be between 2 and " + std::to_string(kMaxLpvResolution) + ", got " +
+                       std::to_string(*args.grid));
+    settings.resolution = *args.grid;
+  }
+  if (!args.steps.empty()) {
+    if (args.steps == "auto") {
+      settings.autoSteps = true;
+    } else {
+      std::size_t used = 0;
+      int steps = -1;
+      try {
+        steps = std::stoi(args.steps, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != args.steps.size() || steps < 1 || steps > kMaxSteps)
+        throw InputError("--steps: expected 'auto' or a whole number from 1 to " + std::to_string(kMaxSteps) +
+                         ", got '" + args.steps + "'");
+      settings.steps = steps;
+      settings.autoSteps = false;
+    }
+  }
+  if (args.shadowMap) {
+    if (*args.shadowMap < 1 || *args.shadowMap > kMaxShadowMap)
+      throw InputError("--shadow-map: must be between 1 and " + std::to_string(kMaxShadowMap));
+    settings.shadowMap = *args.shadowMap;
+  }
+  if (!(args.exposure > 0.0f)) throw InputError("--exposure: must be positive");
+
+  CpuRenderer renderer(scene);
+  RenderReport report;
+  Image image = renderer.render(settings, &report);
+  writeImage(image, args.output, args.exposure);
+  if (args.timings) std::cout << formatTimings(report);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"sslpv: author and preview translucent heterogeneous materials (SSLPV)"};
+  app.require_subcommand(1);
+
+  RenderArgs render;
+  CLI::App* renderCmd = app.add_subcommand("render", "Render a scene with SSLPV");
+  renderCmd->add_option("scene", render.scene, "Scene JSON file")->required();
+  renderCmd->add_option("-o,--output", render.output, "Output image (.png tone-mapped, .pfm/.exr linear)")
+      ->required();
+  renderCmd->add_option("--backend", render.backend, "cpu (vulkan: not built yet)");
+  renderCmd->add_option("--grid", render.grid, "LPV cells along the longest axis (overrides lpv.resolution)");
+  renderCmd->add_option("--steps", render.steps, "Propagation steps, or 'auto' (overrides lpv.steps)");
+  renderCmd->add_option("--shadow-map", render.shadowMap, "Shadow-map texels per side (overrides lpv.shadow_map)");
+  renderCmd->add_option("--exposure", render.exposure, "PNG only: multiply radiance before tone mapping");
+  renderCmd->add_flag("--timings", render.timings, "Print the per-stage timing table");
+
+  std::string inspectFile;
+  CLI::App* inspectCmd = app.add_subcommand("inspect", "Report the grids of a VDB material set and validate it");
+  inspectCmd->add_option("file", inspectFile, "VDB file")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    return fail(kExitInput, std::string(e.what()) + " (see sslpv --help)");
+  }
+
+  try {
+    if (*renderCmd) return runRender(render);
+    if (*inspectCmd) {
+      if (!sslpv::inspectVdbFile(inspectFile, std::cout))
+        return fail(kExitInput, inspectFile + ": the material set has validation problems (listed above)");
+      return 0;
+    }
+  } catch (const sslpv::InputError& e) {
+    return fail(kExitInput, e.what());
+  } catch (const sslpv::ResourceError& e) {
+    return fail(kExitResource, e.what());
+  } catch (const std::bad_alloc&) {
+    return fail(kExitResource, "out of memory");
+  } catch (const std::exception& e) {
+    return fail(kExitInternal, std::string("internal error: ") + e.what());
+  }
+  return kExitInternal;
+}

@@ -29,6 +29,10 @@ struct GridFrame {
   glm::dvec3 cellCenter(int x, int y, int z) const {
     return origin + cellSize * (glm::dvec3(x, y, z) + 0.5);
   }
+  /// The outermost layer of cells never holds light: it is where light leaves the grid.
+  bool onOuterRing(int x, int y, int z) const {
+    return x <= 0 || y <= 0 || z <= 0 || x >= dims.x - 1 || y >= dims.y - 1 || z >= dims.z - 1;
+  }
   /// Continuous cell coordinates: cell (i,j,k) spans [i, i+1) on each axis.
   glm::dvec3 toGrid(const glm::dvec3& world) const { return (world - origin) / cellSize; }
 };
@@ -49,6 +53,12 @@ struct MaterialGrid {
   std::vector<glm::vec3> sigmaS;
   std::vector<float> g;
 };
+
+/// A cell takes part in light transport when part of it is inside the object and it is
+/// not on the outer ring. Injection, propagation and shading all use this definition.
+inline bool isActiveCell(const MaterialGrid& m, int x, int y, int z) {
+  return !m.frame.onOuterRing(x, y, z) && m.coverage[m.frame.index(x, y, z)] > 0.0f;
+}
 
 /// L1 SH light field: coefficient plane c = channel*4 + sh (sh: 0 = Y00, 1..3 = Y1 x,y,z).
 struct ShGrid {

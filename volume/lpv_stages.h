@@ -1,0 +1,107 @@
+#pragma once
+// The stages of one SSLPV frame on the CPU (Børlum et al. 2011): light samples from a
+// shadow map per light, injection as clamped-cosine L1 SH lobes, propagation with
+// extinction and scattering, and shading. This is the reference the GPU backend matches.
+#include <array>
+#include <glm/vec3.hpp>
+#include <vector>
+
+#include "volume/lpv_grid.h"
+#include "volume/mesh.h"
+#include "volume/scene.h"
+
+namespace sslpv {
+
+class RayScene;
+struct Image;
+
+/// Light that crossed the surface at one shadow-map texel.
+struct SurfaceFluxSample {
+  glm::vec3 position;   ///< hit point on the surface (world)
+  glm::vec3 normal;     ///< outward unit normal
+  glm::vec3 direction;  ///< unit direction of the refracted light inside the medium
+  glm::vec3 flux;       ///< transmitted power T * I * dω (or T * E * texel area), per channel
+};
+
+struct ShadowMapStats {
+  std::size_t texels = 0;        ///< texels cast
+  std::size_t hits = 0;          ///< texels whose ray hit the object
+  glm::dvec3 incidentFlux{0.0};  ///< power arriving on the surface
+  glm::dvec3 transmittedFlux{0.0};
+  bool culled = false;           ///< the light cannot reach the object
+};
+
+/// Casts a size x size shadow map of `light` over the object (`bounds`) and returns one
+/// sample per texel that hits it, flux already multiplied by the Fresnel transmittance
+/// for relative index `ior`. Point and spot lights use a perspective map aimed at the
+/// object (a cube map when the light is inside its bounding sphere); directional lights
+/// an orthographic map. Lights that cannot reach the object return nothing (culled).
+std::vector<SurfaceFluxSample> castShadowMap(const Light& light, const RayScene& rays,
+                                             const Bounds& bounds, int size, double ior,
+                                             ShadowMapStats* stats = nullptr);
+
+/// Trilinear weights of the 8 cells around world point p (continuous cell coordinates,
+/// cell centres at half-integers), restricted to cells with coverage > 0 and
+/// renormalized. Returns the number of cells used (0: no active cell nearby).
+int activeTrilinearWeights(const MaterialGrid& material, const glm::dvec3& p,
+                           std::size_t cells[8], float weights[8]);
+
+struct InjectionStats {
+  glm::dvec3 injectedFlux{0.0};  ///< total flux written into the grid
+  glm::dvec3 droppedFlux{0.0};   ///< flux of samples with no active cell nearby
+};
+
+/// Adds each sample as a clamped cosine lobe about its refracted direction, holding
+/// flux/π, half a cell inside the surface, spread trilinearly over active cells.
+InjectionStats injectSamples(const std::vector<SurfaceFluxSample>& samples,
+                             const MaterialGrid& material, ShGrid& grid);
+
+/// Per-step power bookkeeping. Every quantity is total flux (W), per channel.
+struct StepEnergy {
+  glm::dvec3 inGrid{0.0};     ///< power held by the propagating grid after the step
+  glm::dvec3 left{0.0};       ///< power that left through the object's boundary this step
+  glm::dvec3 absorbed{0.0};   ///< power absorbed this step
+  glm::dvec3 clampRemoved{0.0};  ///< power the clamp would have created, removed this step
+};
+
+struct PropagationOptions {
+  int steps = 8;
+  bool autoSteps = false;
+  /// --steps auto: stop once a step adds less than this fraction of the accumulated power.
+  double autoTolerance = 1e-3;
+  int maxAutoSteps = 10000;
+  bool recordEnergy = false;  ///< fill PropagationResult::energy for every step
+};
+
+struct PropagationResult {
+  int stepsRun = 0;
+  glm::dvec3 initialPower{0.0};
+  std::vector<StepEnergy> energy;  ///< one entry per step when recordEnergy
+};
+
+/// Per-cell transport factors of one step, derived from the material grid: the DC band
+/// scales by e + a(1-e), the linear band by e + a(1-e)g, with e = exp(-σt Δx), a = σs/σt.
+struct StepFactors {
+  std::array<std::vector<float>, 3> dc;      ///< per channel, per cell
+  std::array<std::vector<float>, 3> linear;  ///< per channel, per cell
+  std::vector<unsigned char> active;  ///< coverage > 0 and not on the outer ring
+};
+StepFactors computeStepFactors(const MaterialGrid& material);
+
+/// Propagates `field` (the injected light, replaced by the last step's light) for the
+/// requested steps and adds every step, including the injected one, into `accumulated`.
+/// Each step gathers flux from the 6 neighbours through 5 faces of each destination
+/// (exact face solid angles), re-emits it as cosine lobes, then applies extinction and
+/// scattering. The max(0,·) clamp of the face evaluation is renormalized per source cell
+/// so a step never emits more power than the cell holds.
+PropagationResult propagate(const MaterialGrid& material, const StepFactors& factors,
+                            ShGrid& field, ShGrid& accumulated, const PropagationOptions& options);
+
+/// Rasterizes the object from the camera by ray casting; each pixel reads the accumulated
+/// LPV half a cell inside the surface, converts intensity to exitant radiance through the
+/// hemisphere integral, and applies the exit Fresnel transmittance (and the 1/η² radiance
+/// change across the boundary). Background pixels are 0.
+Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
+                 const ShGrid& accumulated, double ior);
+
+}  // namespace sslpv

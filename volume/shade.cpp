@@ -1,0 +1,72 @@
+// Shading: the camera sees the surface; radiance comes from the LPV just inside it.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "volume/fresnel.h"
+#include "volume/image_io.h"
+#include "volume/lpv_stages.h"
+#include "volume/ray_scene.h"
+#include "volume/sh.h"
+
+namespace sslpv {
+
+Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
+                 const ShGrid& accumulated, double ior) {
+  Image image(camera.width, camera.height);
+  const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
+  const glm::dvec3 up = glm::cross(right, forward);
+  const double tanHalfY = std::tan(glm::radians(0.5 * camera.fovYDeg));
+  const double tanHalfX = tanHalfY * camera.width / camera.height;
+  const double cellSize = material.frame.cellSize;
+  // Intensity leaving a cell through its face of area A, spread as a Lambertian
+  // exitance: L = (1/(Aπ)) ∫_H I(ω) dω (the seed's rendering equation).
+  const double radianceScale = 1.0 / (cellSize * cellSize * SSLPV_PI);
+  // Radiance divided by n² is invariant across a boundary; leaving the medium it drops by 1/η².
+  const double boundaryScale = 1.0 / (ior * ior);
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<glm::vec3> origins(camera.width), dirs(camera.width);
+    std::vector<RayHit> hits(camera.width);
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = 0; x < camera.width; ++x) {
+        const double u = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalfX;
+        const double v = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalfY;
+        origins[x] = glm::vec3(camera.position);
+        dirs[x] = glm::vec3(glm::normalize(forward + u * right + v * up));
+      }
+      rays.intersectMany(origins.data(), dirs.data(), hits.data(), std::size_t(camera.width));
+      for (int x = 0; x < camera.width; ++x) {
+        const RayHit& hit = hits[x];
+        if (!hit.hit) continue;
+        const glm::dvec3 n(hit.normal);
+        const double cosOut = -glm::dot(glm::dvec3(dirs[x]), n);
+        if (cosOut <= 0.0) continue;
+        std::size_t cells[8];
+        float weights[8];
+        const glm::dvec3 p(hit.position);
+        int used = activeTrilinearWeights(material, p - 0.5 * cellSize * n, cells, weights);
+        if (used == 0) used = activeTrilinearWeights(material, p - cellSize * n, cells, weights);
+        if (used == 0) continue;
+        const double transmittance = 1.0 - fresnelReflectance(cosOut, ior);
+        glm::vec3 radiance(0.0f);
+        for (int ch = 0; ch < 3; ++ch) {
+          sh::Coeffs c(0.0f);
+          for (int i = 0; i < used; ++i)
+            c += weights[i] * sh::Coeffs(accumulated.plane(ch, 0)[cells[i]], accumulated.plane(ch, 1)[cells[i]],
+                                         accumulated.plane(ch, 2)[cells[i]], accumulated.plane(ch, 3)[cells[i]]);
+          const double exitant = std::max(0.0f, sh::hemisphereIntegral(c, glm::vec3(n)));
+          radiance[ch] = float(exitant * radianceScale * boundaryScale * transmittance);
+        }
+        image.at(x, y) = radiance;
+      }
+    }
+  });
+  return image;
+}
+
+}  // namespace sslpv
