@@ -1,0 +1,305 @@
+#include "volume/mesh.h"
+
+// Orientation note for consumers: loadMesh keeps the winding the file has. Primitives are
+// counter-clockwise seen from outside, but a file may be consistently inside-out
+// (signedVolume < 0); that is accepted, so code that needs "outside" must decide it
+// geometrically (ray parity, |signedVolume|), never from the triangle winding.
+
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <array>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <unordered_map>
+
+#include "volume/error.h"
+
+namespace sslpv {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string formatPoint(const glm::dvec3& p) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g)", p.x, p.y, p.z);
+  return text;
+}
+
+TriangleMesh makeBox(const MeshSource& source) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(source.boxMin[axis] < source.boxMax[axis]) || !std::isfinite(source.boxMin[axis]) ||
+        !std::isfinite(source.boxMax[axis]))
+      throw InputError("box: min " + formatPoint(source.boxMin) + " must be below max " +
+                       formatPoint(source.boxMax) + " on every axis");
+  }
+  TriangleMesh mesh;
+  mesh.name = "box";
+  // Corner i has x from bit 0, y from bit 1, z from bit 2.
+  for (int i = 0; i < 8; ++i) {
+    mesh.positions.emplace_back(glm::dvec3((i & 1) ? source.boxMax.x : source.boxMin.x,
+                                           (i & 2) ? source.boxMax.y : source.boxMin.y,
+                                           (i & 4) ? source.boxMax.z : source.boxMin.z));
+  }
+  // Two triangles a face, counter-clockwise seen from outside.
+  mesh.triangles = {
+      {0, 4, 6}, {0, 6, 2},  // -x
+      {1, 3, 7}, {1, 7, 5},  // +x
+      {0, 1, 5}, {0, 5, 4},  // -y
+      {2, 6, 7}, {2, 7, 3},  // +y
+      {0, 2, 3}, {0, 3, 1},  // -z
+      {4, 5, 7}, {4, 7, 6},  // +z
+  };
+  return mesh;
+}
+
+/// Geodesic icosphere: uniform triangles (no pole pinching, unlike a UV sphere), 20 * 4^5 =
+/// 20480 triangles, enough that its volume is within 0.1 % of the true sphere's.
+TriangleMesh makeSphere(const MeshSource& source) {
+  if (!(source.radius > 0.0) || !std::isfinite(source.radius) ||
+      !std::isfinite(glm::length(source.center)))
+    throw InputError("sphere: radius must be positive and finite, got " + std::to_string(source.radius));
+  constexpr int kSubdivisions = 5;
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<glm::dvec3> unit = {
+      {-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+      {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1},
+  };
+  for (auto& p : unit) p = glm::normalize(p);
+  std::vector<glm::uvec3> triangles = {
+      {0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+      {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1},
+  };
+  for (int level = 0; level < kSubdivisions; ++level) {
+    // Each edge is split once and its midpoint shared by both neighbours: the sphere stays
+    // welded and closed.
+    std::unordered_map<std::uint64_t, unsigned> midpoints;
+    midpoints.reserve(triangles.size() * 2);
+    auto midpoint = [&](unsigned a, unsigned b) {
+      std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+      auto [it, inserted] = midpoints.try_emplace(key, unsigned(unit.size()));
+      if (inserted) unit.push_back(glm::normalize(unit[a] + unit[b]));
+      return it->second;
+    };
+    std::vector<glm::uvec3> finer;
+    finer.reserve(triangles.size() * 4);
+    for (const auto& tri : triangles) {
+      unsigned ab = midpoint(tri.x, tri.y), bc = midpoint(tri.y, tri.z), ca = midpoint(tri.z, tri.x);
+      finer.push_back({tri.x, ab, ca});
+      finer.push_back({tri.y, bc, ab});
+      finer.push_back({tri.z, ca, bc});
+      finer.push_back({ab, bc, ca});
+    }
+    triangles.swap(finer);
+  }
+  TriangleMesh mesh;
+  mesh.name = "sphere";
+  mesh.positions.reserve(unit.size());
+  for (const auto& p : unit) mesh.positions.emplace_back(source.center + source.radius * p);
+  mesh.triangles = std::move(triangles);
+  return mesh;
+}
+
+/// Merges vertices at bit-identical positions. Importers split vertices at normal and UV
+/// seams (and STL stores every triangle's corners separately), which would make a closed
+/// surface look full of holes.
+void weldExactDuplicates(TriangleMesh& mesh) {
+  struct KeyHash {
+    std::size_t operator()(const std::array<std::uint32_t, 3>& k) const {
+      std::uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
+      h = (h ^ (h >> 29) ^ k[1]) * 0xBF58476D1CE4E5B9ull;
+      h = (h ^ (h >> 31) ^ k[2]) * 0x94D049BB133111EBull;
+      return std::size_t(h ^ (h >> 32));
+    }
+  };
+  auto keyOf = [](const glm::vec3& p) {
+    std::array<std::uint32_t, 3> key;
+    for (int i = 0; i < 3; ++i) {
+      float v = p[i] + 0.0f;  // -0 and +0 are the same point
+      std::memcpy(&key[i], &v, sizeof v);
+    }
+    return key;
+  };
+  std::unordered_map<std::array<std::uint32_t, 3>, unsigned, KeyHash> firstIndex;
+  firstIndex.reserve(mesh.positions.size());
+  std::vector<unsigned> remap(mesh.positions.size());
+  std::vector<glm::vec3> welded;
+  welded.reserve(mesh.positions.size());
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    auto [it, inserted] = firstIndex.try_emplace(keyOf(mesh.positions[i]), unsigned(welded.size()));
+    if (inserted) welded.push_back(mesh.positions[i]);
+    remap[i] = it->second;
+  }
+  for (auto& tri : mesh.triangles) tri = glm::uvec3(remap[tri.x], remap[tri.y], remap[tri.z]);
+  mesh.positions.swap(welded);
+}
+
+TriangleMesh loadMeshFile(const fs::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(name + ": mesh file not found");
+  if (!fs::is_regular_file(path, ec)) throw InputError(name + ": mesh path is not a regular file");
+  if (!std::ifstream(path, std::ios::binary).good())
+    throw InputError(name + ": cannot read mesh file (" + std::strerror(errno) + ")");
+
+  Assimp::Importer importer;
+  auto failure = [&] {
+    std::string reason = importer.GetErrorString();
+    std::replace(reason.begin(), reason.end(), '\n', ' ');
+    return InputError(name + ": cannot load mesh: " + (reason.empty() ? "unknown assimp error" : reason));
+  };
+  // Face indices are range-checked below rather than with aiProcess_ValidateDataStructure,
+  // whose messages ("aiScene::mNumMeshes is 0") would only confuse a user.
+  const aiScene* scene =
+      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  if (!scene) throw failure();
+  bool anyFace = false;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+    anyFace = anyFace || (scene->mMeshes[m] && scene->mMeshes[m]->mNumFaces > 0);
+  // Checked before PreTransformVertices, which reports a point cloud as "all meshes are
+  // orphaned" instead.
+  if (!anyFace) throw InputError(name + ": mesh file contains no triangles");
+  // Bakes the node hierarchy into the vertices, so multi-part files (FBX, glTF) come out
+  // in their authored layout, all parts in one frame.
+  scene = importer.ApplyPostProcessing(aiProcess_PreTransformVertices);
+  if (!scene) throw failure();
+
+  TriangleMesh mesh;
+  mesh.name = name;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* part = scene->mMeshes[m];
+    if (!part || !part->mVertices || (part->mNumFaces > 0 && !part->mFaces)) continue;
+    const std::size_t base = mesh.positions.size();
+    if (base + part->mNumVertices > std::numeric_limits<unsigned>::max())
+      throw InputError(name + ": too many vertices for 32-bit indices");
+    for (unsigned v = 0; v < part->mNumVertices; ++v) {
+      const aiVector3D& p = part->mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw InputError(name + ": vertex " + std::to_string(base + v) + " has a non-finite coordinate");
+      mesh.positions.emplace_back(p.x, p.y, p.z);
+    }
+    // Points and lines (faces with 1 or 2 indices) bound no volume; they are not surface.
+    for (unsigned f = 0; f < part->mNumFaces; ++f) {
+      const aiFace& face = part->mFaces[f];
+      if (face.mNumIndices != 3 || !face.mIndices) continue;
+      for (unsigned k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= part->mNumVertices)
+          throw InputError(name + ": face " + std::to_string(f) + " of mesh " + std::to_string(m) +
+                           " indexes a missing vertex");
+      }
+      mesh.triangles.emplace_back(base + face.mIndices[0], base + face.mIndices[1],
+                                  base + face.mIndices[2]);
+    }
+  }
+  if (mesh.triangles.empty()) throw InputError(name + ": mesh file contains no triangles");
+  weldExactDuplicates(mesh);
+  return mesh;
+}
+
+struct TopologyDetails {
+  MeshTopology counts;
+  glm::dvec3 boundaryExample{0.0};     ///< midpoint of one boundary edge
+  glm::dvec3 nonManifoldExample{0.0};  ///< midpoint of one non-manifold edge
+};
+
+TopologyDetails analyze(const TriangleMesh& mesh) {
+  TopologyDetails details;
+  // Sorting packed 64-bit edge keys is several times faster than hashing index pairs and
+  // keeps 1M-triangle meshes well under a second.
+  std::vector<std::uint64_t> edges;
+  edges.reserve(mesh.triangles.size() * 3);
+  for (const auto& tri : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      edges.push_back((std::uint64_t(std::min(a, b)) << 32) | std::max(a, b));
+    }
+    glm::dvec3 p0(mesh.positions[tri.x]), p1(mesh.positions[tri.y]), p2(mesh.positions[tri.z]);
+    glm::dvec3 e1 = p1 - p0, e2 = p2 - p0;
+    double longest2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(p2 - p1, p2 - p1)});
+    // Relative test: float vertices on a line give a cross product of rounding size only.
+    double area2 = glm::length(glm::cross(e1, e2));
+    if (!(area2 > 1e-12 * longest2)) ++details.counts.degenerateTriangles;
+  }
+  tbb::parallel_sort(edges.begin(), edges.end());
+  auto midpoint = [&](std::uint64_t key) {
+    return 0.5 * (glm::dvec3(mesh.positions[key >> 32]) + glm::dvec3(mesh.positions[key & 0xffffffffu]));
+  };
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    std::size_t uses = j - i;
+    if (uses == 1) {
+      if (details.counts.boundaryEdges++ == 0) details.boundaryExample = midpoint(edges[i]);
+    } else if (uses >= 3) {
+      if (details.counts.nonManifoldEdges++ == 0) details.nonManifoldExample = midpoint(edges[i]);
+    }
+    i = j;
+  }
+  return details;
+}
+
+}  // namespace
+
+TriangleMesh loadMesh(const MeshSource& source, const Transform& transform) {
+  TriangleMesh mesh;
+  switch (source.kind) {
+    case MeshSource::Kind::Box: mesh = makeBox(source); break;
+    case MeshSource::Kind::Sphere: mesh = makeSphere(source); break;
+    case MeshSource::Kind::File: mesh = loadMeshFile(source.path); break;
+  }
+  if (!(transform.scale > 0.0) || !std::isfinite(transform.scale))
+    throw InputError(mesh.name + ": transform scale must be positive, got " + std::to_string(transform.scale));
+  const glm::dmat4 toWorld = transform.matrix();
+  for (auto& p : mesh.positions) p = glm::vec3(toWorld * glm::dvec4(glm::dvec3(p), 1.0));
+  return mesh;
+}
+
+MeshTopology analyzeTopology(const TriangleMesh& mesh) { return analyze(mesh).counts; }
+
+double signedVolume(const TriangleMesh& mesh) {
+  if (mesh.positions.empty()) return 0.0;
+  // Divergence theorem: sum of tetrahedra from a reference point to each triangle. Using
+  // the bounds centre instead of the origin avoids cancellation for meshes far from it.
+  const Bounds bounds = mesh.bounds();
+  const glm::dvec3 ref = 0.5 * (bounds.min + bounds.max);
+  double sixTimesVolume = 0.0;
+  for (const auto& tri : mesh.triangles) {
+    glm::dvec3 a = glm::dvec3(mesh.positions[tri.x]) - ref;
+    glm::dvec3 b = glm::dvec3(mesh.positions[tri.y]) - ref;
+    glm::dvec3 c = glm::dvec3(mesh.positions[tri.z]) - ref;
+    sixTimesVolume += glm::dot(a, glm::cross(b, c));
+  }
+  return sixTimesVolume / 6.0;
+}
+
+void requireClosedMesh(const TriangleMesh& mesh) {
+  const std::string watertight = "; SSLPV needs a watertight surface";
+  if (mesh.triangles.empty()) throw InputError(mesh.name + ": mesh has no triangles");
+  const TopologyDetails details = analyze(mesh);
+  if (details.counts.boundaryEdges > 0)
+    throw InputError(mesh.name + ": mesh is not closed: " + std::to_string(details.counts.boundaryEdges) +
+                     " boundary edges (a hole near " + formatPoint(details.boundaryExample) + ")" +
+                     watertight);
+  if (details.counts.nonManifoldEdges > 0)
+    throw InputError(mesh.name + ": mesh is not manifold: " +
+                     std::to_string(details.counts.nonManifoldEdges) +
+                     " edges shared by 3 or more triangles (one near " +
+                     formatPoint(details.nonManifoldExample) + ")" + watertight);
+  // Relative to the bounding box so that the check is independent of the scene's units.
+  const glm::dvec3 extent = mesh.bounds().extent();
+  const double volume = std::abs(signedVolume(mesh));
+  if (!(volume > 1e-9 * extent.x * extent.y * extent.z) || !(volume > 0.0))
+    throw InputError(mesh.name + ": mesh encloses no volume (its triangles cancel out or are flat)" +
+                     watertight);
+}
+
+}  // namespace sslpv

@@ -1,0 +1,524 @@
+#include "volume/scene.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string_view>
+
+#include "volume/error.h"
+
+namespace sslpv {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Key names and string values are echoed into one-line messages: a control character
+// (a JSON "\n" in a key, say) must not break the line.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::string childPath(const std::string& path, std::string_view key) {
+  return path.empty() ? printable(key) : path + "." + printable(key);
+}
+
+std::string indexPath(const std::string& path, std::size_t index) {
+  return path + "[" + std::to_string(index) + "]";
+}
+
+std::string formatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", value);
+  return text;
+}
+
+std::string quotedList(std::initializer_list<const char*> names) {
+  std::string out;
+  for (const char* name : names) {
+    if (!out.empty()) out += ", ";
+    out += '"';
+    out += name;
+    out += '"';
+  }
+  return out;
+}
+
+/// "an object", "a string", ... for "expected X, got Y" messages.
+std::string describeType(const json& value) {
+  switch (value.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::object: return "an object";
+    case json::value_t::array: return "an array";
+    case json::value_t::string: return "a string";
+    case json::value_t::boolean: return "a boolean";
+    case json::value_t::binary: return "binary data";
+    case json::value_t::discarded: return "nothing";
+    default: return "a number";
+  }
+}
+
+/// Turns nlohmann's byte offset into the line and column an editor shows (both from 1).
+std::string lineAndColumn(const std::string& text, std::size_t byte) {
+  std::size_t index = byte == 0 ? 0 : std::min(byte - 1, text.size());
+  std::size_t line = 1, lineStart = 0;
+  for (std::size_t i = 0; i < index; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      lineStart = i + 1;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(index - lineStart + 1);
+}
+
+/// nlohmann prefixes its messages with "[json.exception.parse_error.101] parse error at
+/// line 1, column 2: "; the location is reported separately, so keep only the reason.
+std::string jsonReason(const std::string& what) {
+  std::string reason = what;
+  if (auto bracket = reason.find("] "); reason.rfind("[json.exception", 0) == 0 &&
+                                        bracket != std::string::npos)
+    reason = reason.substr(bracket + 2);
+  if (reason.rfind("parse error", 0) == 0) {
+    if (auto colon = reason.find(": "); colon != std::string::npos) reason = reason.substr(colon + 2);
+  }
+  return printable(reason);
+}
+
+/// Tracks where the parser is so a duplicated key can be named by its path. nlohmann keeps
+/// the last of two equal keys silently, which would hide a typo like a second "steps".
+class DuplicateKeyGuard {
+ public:
+  explicit DuplicateKeyGuard(const fs::path& file) : file_(file) {}
+
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start: frames_.push_back({false, 0, {}, {}}); break;
+      case json::parse_event_t::array_start: frames_.push_back({true, 0, {}, {}}); break;
+      case json::parse_event_t::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second)
+          throw InputError(file_.string() + ": " + childPath(enclosingPath(), top.key) +
+                           ": duplicate key");
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_.pop_back();
+        completeValue();
+        break;
+      case json::parse_event_t::value: completeValue(); break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool isArray;
+    std::size_t index;  // arrays: elements completed so far
+    std::string key;    // objects: the key being parsed
+    std::set<std::string> keys;
+  };
+
+  void completeValue() {
+    if (!frames_.empty() && frames_.back().isArray) ++frames_.back().index;
+  }
+
+  // Path of the innermost open object (the one receiving the key).
+  std::string enclosingPath() const {
+    std::string path;
+    for (std::size_t i = 0; i + 1 < frames_.size(); ++i)
+      path = frames_[i].isArray ? indexPath(path, frames_[i].index)
+                                : childPath(path, frames_[i].key);
+    return path;
+  }
+
+  const fs::path& file_;
+  std::vector<Frame> frames_;
+};
+
+/// Reads values out of the parsed document; every failure names the file and key path.
+class SceneReader {
+ public:
+  explicit SceneReader(const fs::path& file) : file_(file) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
+    throw InputError(file_.string() + ": " + (path.empty() ? "" : path + ": ") + reason);
+  }
+
+  void requireObject(const json& value, const std::string& path) const {
+    if (!value.is_object()) fail(path, "expected an object, got " + describeType(value));
+  }
+
+  /// Strictness: a misspelt key must not be ignored silently.
+  void allowOnly(const json& object, const std::string& path,
+                 std::initializer_list<const char*> accepted) const {
+    for (const auto& item : object.items()) {
+      bool known = false;
+      for (const char* name : accepted) known = known || item.key() == name;
+      if (!known)
+        fail(childPath(path, item.key()), "unknown key (accepted keys: " + quotedList(accepted) + ")");
+    }
+  }
+
+  const json* optional(const json& object, const char* key) const {
+    auto it = object.find(key);
+    return it == object.end() ? nullptr : &*it;
+  }
+
+  const json& required(const json& object, const std::string& path, const char* key) const {
+    auto it = object.find(key);
+    if (it == object.end()) fail(path, std::string("missing required key \"") + key + "\"");
+    return *it;
+  }
+
+  double number(const json& value, const std::string& path) const {
+    if (!value.is_number()) fail(path, "expected a number, got " + describeType(value));
+    double result = value.get<double>();
+    if (!std::isfinite(result)) fail(path, "expected a finite number");
+    return result;
+  }
+
+  int integer(const json& value, const std::string& path, int lo, int hi) const {
+    std::string expected = "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (!value.is_number()) fail(path, expected + ", got " + describeType(value));
+    double result = value.get<double>();
+    if (result != std::floor(result)) fail(path, expected + ", got " + formatNumber(result));
+    if (!(result >= lo && result <= hi)) fail(path, expected + ", got " + formatNumber(result));
+    return static_cast<int>(result);
+  }
+
+  std::string string(const json& value, const std::string& path) const {
+    if (!value.is_string()) fail(path, "expected a string, got " + describeType(value));
+    return value.get<std::string>();
+  }
+
+  glm::dvec3 vec3(const json& value, const std::string& path, const char* what = "numbers") const {
+    std::string expected = std::string("expected an array of 3 ") + what;
+    if (!value.is_array() || value.size() != 3) {
+      fail(path, expected + ", got " +
+                     (value.is_array() ? "an array of " + std::to_string(value.size())
+                                       : describeType(value)));
+    }
+    glm::dvec3 result;
+    for (int i = 0; i < 3; ++i) {
+      const json& element = value[std::size_t(i)];
+      if (!element.is_number() || !std::isfinite(element.get<double>()))
+        fail(indexPath(path, i), expected + ", got " + describeType(element));
+      result[i] = element.get<double>();
+    }
+    return result;
+  }
+
+  /// RGB radiometric quantities and coefficients: finite and non-negative.
+  glm::dvec3 nonNegativeRgb(const json& value, const std::string& path) const {
+    glm::dvec3 result = vec3(value, path, "non-negative numbers");
+    for (int i = 0; i < 3; ++i) {
+      if (result[i] < 0.0)
+        fail(indexPath(path, i), "expected a non-negative number, got " + formatNumber(result[i]));
+    }
+    return result;
+  }
+
+  glm::dvec3 direction(const json& value, const std::string& path) const {
+    glm::dvec3 result = vec3(value, path);
+    double length = glm::length(result);
+    if (!(length > 0.0) || !std::isfinite(length)) fail(path, "expected a non-zero direction vector");
+    return result / length;
+  }
+
+  double openInterval(const json& value, const std::string& path, double lo, double hi) const {
+    double result = number(value, path);
+    if (!(result > lo && result < hi))
+      fail(path, "must be in (" + formatNumber(lo) + ", " + formatNumber(hi) + "), got " +
+                     formatNumber(result));
+    return result;
+  }
+
+  /// Relative paths are taken from the scene file's folder, so a scene works from any cwd.
+  fs::path filePath(const json& value, const std::string& path) const {
+    std::string text = string(value, path);
+    if (text.empty()) fail(path, "expected a non-empty file path");
+    return (file_.parent_path() / fs::path(text)).lexically_normal();
+  }
+
+ private:
+  const fs::path& file_;
+};
+
+MeshSource parseMesh(const SceneReader& in, const json& node) {
+  const std::string path = "mesh";
+  in.requireObject(node, path);
+  MeshSource mesh;
+  const json* file = in.optional(node, "path");
+  const json* primitive = in.optional(node, "primitive");
+  if (file && primitive) in.fail(path, "give either \"path\" or \"primitive\", not both");
+  if (!file && !primitive) in.fail(path, "missing required key \"path\" or \"primitive\"");
+  if (file) {
+    in.allowOnly(node, path, {"path"});
+    mesh.kind = MeshSource::Kind::File;
+    mesh.path = in.filePath(*file, childPath(path, "path"));
+    return mesh;
+  }
+  std::string kind = in.string(*primitive, childPath(path, "primitive"));
+  if (kind == "box") {
+    in.allowOnly(node, path, {"primitive", "min", "max"});
+    mesh.kind = MeshSource::Kind::Box;
+    mesh.boxMin = in.vec3(in.required(node, path, "min"), childPath(path, "min"));
+    mesh.boxMax = in.vec3(in.required(node, path, "max"), childPath(path, "max"));
+    static const char* const kAxis[] = {"x", "y", "z"};
+    for (int i = 0; i < 3; ++i) {
+      if (!(mesh.boxMin[i] < mesh.boxMax[i]))
+        in.fail(childPath(path, "max"), std::string("must exceed mesh.min on every axis (") +
+                                            kAxis[i] + ": " + formatNumber(mesh.boxMax[i]) +
+                                            " <= " + formatNumber(mesh.boxMin[i]) + ")");
+    }
+  } else if (kind == "sphere") {
+    in.allowOnly(node, path, {"primitive", "center", "radius"});
+    mesh.kind = MeshSource::Kind::Sphere;
+    mesh.center = in.vec3(in.required(node, path, "center"), childPath(path, "center"));
+    std::string radiusPath = childPath(path, "radius");
+    mesh.radius = in.number(in.required(node, path, "radius"), radiusPath);
+    if (!(mesh.radius > 0.0)) in.fail(radiusPath, "must be positive, got " + formatNumber(mesh.radius));
+  } else {
+    in.fail(childPath(path, "primitive"),
+            "unknown primitive \"" + printable(kind) + "\" (accepted: \"box\", \"sphere\")");
+  }
+  return mesh;
+}
+
+Transform parseTransform(const SceneReader& in, const json& node) {
+  const std::string path = "transform";
+  in.requireObject(node, path);
+  in.allowOnly(node, path, {"translate", "rotate_deg", "scale"});
+  Transform transform;
+  if (const json* v = in.optional(node, "translate")) transform.translate = in.vec3(*v, childPath(path, "translate"));
+  if (const json* v = in.optional(node, "rotate_deg")) transform.rotateDeg = in.vec3(*v, childPath(path, "rotate_deg"));
+  if (const json* v = in.optional(node, "scale")) {
+    std::string scalePath = childPath(path, "scale");
+    transform.scale = in.number(*v, scalePath);
+    if (!(transform.scale > 0.0)) in.fail(scalePath, "must be positive, got " + formatNumber(transform.scale));
+  }
+  return transform;
+}
+
+float parseG(const SceneReader& in, const json& value, const std::string& path) {
+  double g = in.number(value, path);
+  if (!(std::abs(g) < 1.0)) in.fail(path, "must be in (-1, 1), got " + formatNumber(g));
+  return static_cast<float>(g);
+}
+
+MaterialSpec parseMaterial(const SceneReader& in, const json& node, double unitMm) {
+  const std::string path = "material";
+  in.requireObject(node, path);
+  in.allowOnly(node, path, {"base", "vdb", "ior"});
+  MaterialSpec spec;
+
+  const std::string basePath = childPath(path, "base");
+  const json& base = in.required(node, path, "base");
+  in.requireObject(base, basePath);
+  if (const json* preset = in.optional(base, "preset")) {
+    in.allowOnly(base, basePath, {"preset", "g"});
+    std::string presetPath = childPath(basePath, "preset");
+    spec.presetName = in.string(*preset, presetPath);
+    float g = 0.0f;
+    if (const json* v = in.optional(base, "g")) g = parseG(in, *v, childPath(basePath, "g"));
+    std::optional<MaterialSample> sample = presetMaterial(spec.presetName, g, unitMm);
+    if (!sample)
+      in.fail(presetPath, "unknown preset \"" + printable(spec.presetName) + "\" (accepted: " +
+                              presetNames() + ")");
+    spec.base = *sample;
+  } else {
+    in.allowOnly(base, basePath, {"sigma_t", "sigma_s", "g", "preset"});
+    std::string tPath = childPath(basePath, "sigma_t"), sPath = childPath(basePath, "sigma_s");
+    glm::dvec3 sigmaT = in.nonNegativeRgb(in.required(base, basePath, "sigma_t"), tPath);
+    glm::dvec3 sigmaS = in.nonNegativeRgb(in.required(base, basePath, "sigma_s"), sPath);
+    for (int c = 0; c < 3; ++c) {
+      if (sigmaS[c] > sigmaT[c])
+        in.fail(indexPath(sPath, c), "exceeds sigma_t (" + formatNumber(sigmaS[c]) + " > " +
+                                         formatNumber(sigmaT[c]) + "): albedo above 1");
+    }
+    spec.base.sigmaT = glm::vec3(sigmaT);
+    spec.base.sigmaS = glm::vec3(sigmaS);
+    // Rounding to float must not push the albedo above 1 when sigma_s == sigma_t.
+    spec.base.sigmaS = glm::min(spec.base.sigmaS, spec.base.sigmaT);
+    if (const json* v = in.optional(base, "g")) spec.base.g = parseG(in, *v, childPath(basePath, "g"));
+  }
+
+  if (const json* v = in.optional(node, "vdb")) spec.vdb = in.filePath(*v, childPath(path, "vdb"));
+  if (const json* v = in.optional(node, "ior")) {
+    std::string iorPath = childPath(path, "ior");
+    spec.ior = in.number(*v, iorPath);
+    // Relative indices outside this range do not occur in real materials; such a value is
+    // almost certainly a typo (e.g. 15 for 1.5).
+    if (!(spec.ior >= 0.2 && spec.ior <= 5.0))
+      in.fail(iorPath, "must be in [0.2, 5], got " + formatNumber(spec.ior));
+  }
+  return spec;
+}
+
+Light parseLight(const SceneReader& in, const json& node, const std::string& path) {
+  in.requireObject(node, path);
+  Light light;
+  std::string typePath = childPath(path, "type");
+  std::string type = in.string(in.required(node, path, "type"), typePath);
+  auto rgb = [&](const char* key) {
+    return glm::vec3(in.nonNegativeRgb(in.required(node, path, key), childPath(path, key)));
+  };
+  auto vec = [&](const char* key) { return in.vec3(in.required(node, path, key), childPath(path, key)); };
+  auto dir = [&](const char* key) {
+    return in.direction(in.required(node, path, key), childPath(path, key));
+  };
+  if (type == "point") {
+    in.allowOnly(node, path, {"type", "position", "intensity"});
+    light.type = Light::Type::Point;
+    light.position = vec("position");
+    light.intensity = rgb("intensity");
+  } else if (type == "spot") {
+    in.allowOnly(node, path, {"type", "position", "direction", "fov_deg", "intensity"});
+    light.type = Light::Type::Spot;
+    light.position = vec("position");
+    light.direction = dir("direction");
+    light.fovDeg = in.openInterval(in.required(node, path, "fov_deg"), childPath(path, "fov_deg"), 0.0, 180.0);
+    light.intensity = rgb("intensity");
+  } else if (type == "directional") {
+    in.allowOnly(node, path, {"type", "direction", "irradiance"});
+    light.type = Light::Type::Directional;
+    light.direction = dir("direction");
+    light.irradiance = rgb("irradiance");
+  } else {
+    in.fail(typePath, "unknown light type \"" + printable(type) +
+                          "\" (accepted: \"point\", \"spot\", \"directional\")");
+  }
+  return light;
+}
+
+Camera parseCamera(const SceneReader& in, const json& node) {
+  const std::string path = "camera";
+  in.requireObject(node, path);
+  in.allowOnly(node, path, {"position", "target", "up", "fov_y_deg", "width", "height"});
+  Camera camera;
+  camera.position = in.vec3(in.required(node, path, "position"), childPath(path, "position"));
+  camera.target = in.vec3(in.required(node, path, "target"), childPath(path, "target"));
+  if (const json* v = in.optional(node, "up")) camera.up = in.direction(*v, childPath(path, "up"));
+  camera.fovYDeg = in.openInterval(in.required(node, path, "fov_y_deg"), childPath(path, "fov_y_deg"), 0.0, 180.0);
+  camera.width = in.integer(in.required(node, path, "width"), childPath(path, "width"), 1, kMaxImageSide);
+  camera.height = in.integer(in.required(node, path, "height"), childPath(path, "height"), 1, kMaxImageSide);
+
+  glm::dvec3 view = camera.target - camera.position;
+  double viewLength = glm::length(view);
+  if (!(viewLength > 0.0)) in.fail(childPath(path, "target"), "equals camera.position: the view direction is undefined");
+  // A nearly parallel up vector leaves the camera's roll undefined (and its basis noisy).
+  if (glm::length(glm::cross(view / viewLength, camera.up)) < 1e-6)
+    in.fail(childPath(path, "up"), "is parallel to the view direction (camera.target - camera.position)");
+  return camera;
+}
+
+LpvSettings parseLpv(const SceneReader& in, const json& node) {
+  const std::string path = "lpv";
+  in.requireObject(node, path);
+  in.allowOnly(node, path, {"resolution", "steps", "shadow_map"});
+  LpvSettings lpv;
+  if (const json* v = in.optional(node, "resolution"))
+    lpv.resolution = in.integer(*v, childPath(path, "resolution"), 2, kMaxLpvResolution);
+  if (const json* v = in.optional(node, "steps")) {
+    std::string stepsPath = childPath(path, "steps");
+    if (v->is_string()) {
+      if (v->get<std::string>() != "auto")
+        in.fail(stepsPath, "expected an integer in [1, " + std::to_string(kMaxSteps) +
+                               "] or \"auto\", got \"" + printable(v->get<std::string>()) + "\"");
+      lpv.autoSteps = true;
+    } else {
+      lpv.steps = in.integer(*v, stepsPath, 1, kMaxSteps);
+    }
+  }
+  if (const json* v = in.optional(node, "shadow_map"))
+    lpv.shadowMap = in.integer(*v, childPath(path, "shadow_map"), 1, kMaxShadowMap);
+  return lpv;
+}
+
+}  // namespace
+
+glm::dmat4 Transform::matrix() const {
+  glm::dmat4 m = glm::translate(glm::dmat4(1.0), translate);
+  m = glm::rotate(m, glm::radians(rotateDeg.z), glm::dvec3(0, 0, 1));
+  m = glm::rotate(m, glm::radians(rotateDeg.y), glm::dvec3(0, 1, 0));
+  m = glm::rotate(m, glm::radians(rotateDeg.x), glm::dvec3(1, 0, 0));
+  return glm::scale(m, glm::dvec3(scale));
+}
+
+Scene parseScene(const std::string& jsonText, const fs::path& file) {
+  if (jsonText.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw InputError(file.string() + ": empty file");
+  json root;
+  try {
+    root = json::parse(jsonText, DuplicateKeyGuard(file));
+  } catch (const json::parse_error& e) {
+    throw InputError(file.string() + ": " + lineAndColumn(jsonText, e.byte) +
+                     ": malformed JSON: " + jsonReason(e.what()));
+  } catch (const json::exception& e) {
+    throw InputError(file.string() + ": malformed JSON: " + jsonReason(e.what()));
+  }
+
+  SceneReader in(file);
+  if (!root.is_object()) in.fail("", "expected a JSON object at the top level, got " + describeType(root));
+  in.allowOnly(root, "", {"units", "mesh", "transform", "material", "lights", "camera", "lpv"});
+
+  Scene scene;
+  scene.file = file;
+  if (const json* v = in.optional(root, "units")) {
+    scene.units = in.string(*v, "units");
+    std::optional<double> mm = unitInMm(scene.units);
+    if (!mm) in.fail("units", "unknown unit \"" + printable(scene.units) + "\" (accepted: \"mm\", \"cm\", \"m\", \"in\")");
+    scene.unitInMm = *mm;
+  }
+  scene.mesh = parseMesh(in, in.required(root, "", "mesh"));
+  if (const json* v = in.optional(root, "transform")) scene.transform = parseTransform(in, *v);
+  scene.material = parseMaterial(in, in.required(root, "", "material"), scene.unitInMm);
+
+  const json& lights = in.required(root, "", "lights");
+  if (!lights.is_array()) in.fail("lights", "expected an array of lights, got " + describeType(lights));
+  if (lights.empty()) in.fail("lights", "expected at least one light");
+  for (std::size_t i = 0; i < lights.size(); ++i)
+    scene.lights.push_back(parseLight(in, lights[i], indexPath("lights", i)));
+
+  scene.camera = parseCamera(in, in.required(root, "", "camera"));
+  if (const json* v = in.optional(root, "lpv")) scene.lpv = parseLpv(in, *v);
+  return scene;
+}
+
+Scene loadScene(const fs::path& file) {
+  auto cannotRead = [&](int error) {
+    return InputError(file.string() + ": cannot read scene file (" + std::strerror(error) + ")");
+  };
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) throw cannotRead(EISDIR);
+  std::FILE* stream = std::fopen(file.c_str(), "rb");
+  if (!stream) throw cannotRead(errno);
+  std::string text;
+  char buffer[65536];
+  std::size_t got = 0;
+  while ((got = std::fread(buffer, 1, sizeof buffer, stream)) > 0) text.append(buffer, got);
+  int readError = std::ferror(stream) ? errno : 0;
+  std::fclose(stream);
+  if (readError != 0) throw cannotRead(readError);
+  return parseScene(text, file);
+}
+
+}  // namespace sslpv
