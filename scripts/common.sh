@@ -9,6 +9,7 @@ SSLPV_PACKAGES=(
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libglm-dev libembree-dev
   libassimp-dev nlohmann-json3-dev libcli11-dev libopenexr-dev libstb-dev
   libgtest-dev libgmock-dev
+  libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools vulkan-validationlayers
 )
 
 sslpv_install_packages() {
