@@ -85,6 +85,9 @@ struct StepFactors {
   std::array<std::vector<float>, 3> dc;      ///< per channel, per cell
   std::array<std::vector<float>, 3> linear;  ///< per channel, per cell
   std::vector<unsigned char> active;  ///< coverage > 0 and not on the outer ring
+  /// Per (y, z) row: does it hold any active cell? Rows without one never hold light and
+  /// are skipped, so cost follows the object's cells rather than its bounding box.
+  std::vector<unsigned char> rowActive;
 };
 StepFactors computeStepFactors(const MaterialGrid& material);
 

@@ -36,18 +36,19 @@ class FlushDenormals {
 };
 
 /// Sum of Δω_f · max(0, I(ω_f)) over the 30 faces a cell sends light through.
-inline float clampedFaceFlux(float c0, const float c[3]) {
+inline float clampedFaceFlux(float c0, float cx, float cy, float cz) {
   const float base = c0 * sh::kY00;
+  const float c[3] = {cx, cy, cz};
   float total = 0.0f;
   for (int a = 0; a < 3; ++a) {
-    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+    const float h1 = (0.5f * sh::kY1 * kSideNorm) * c[(a + 1) % 3];
+    const float h2 = (0.5f * sh::kY1 * kSideNorm) * c[(a + 2) % 3];
     for (int sd = -1; sd <= 1; sd += 2) {
       const float along = sd * sh::kY1 * c[a];
       total += kFront * std::max(0.0f, base + along);
-      const float alongSide = along * kSideNorm;
-      const float h1 = 0.5f * sh::kY1 * c[b1] * kSideNorm, h2 = 0.5f * sh::kY1 * c[b2] * kSideNorm;
-      total += kSide * (std::max(0.0f, base + alongSide + h1) + std::max(0.0f, base + alongSide - h1) +
-                        std::max(0.0f, base + alongSide + h2) + std::max(0.0f, base + alongSide - h2));
+      const float alongSide = base + along * kSideNorm;
+      total += kSide * (std::max(0.0f, alongSide + h1) + std::max(0.0f, alongSide - h1) +
+                        std::max(0.0f, alongSide + h2) + std::max(0.0f, alongSide - h2));
     }
   }
   return total;
@@ -59,101 +60,118 @@ struct SliceSums {
 
 /// Rescales each active cell's coefficients so that the clamped face fluxes add up to
 /// exactly the power it holds. Without it the clamp creates energy (a pure cosine lobe
-/// gains ~14% per step); with it a step can only keep or lose power.
+/// gains ~14% per step); with it a step can only keep or lose power. Inactive cells hold
+/// no light, so the rows are processed whole (branch-free, vectorized).
 void normalizeEmission(const StepFactors& factors, ShGrid& field, std::vector<SliceSums>& sums) {
   const GridFrame& f = field.frame;
-  tbb::parallel_for(0, f.dims.z, [&](int z) {
+  tbb::parallel_for(1, f.dims.z - 1, [&](int z) {
     FlushDenormals flush;
     SliceSums& s = sums[z];
-    for (int y = 0; y < f.dims.y; ++y)
-      for (int x = 0; x < f.dims.x; ++x) {
-        const std::size_t i = f.index(x, y, z);
-        if (!factors.active[i]) continue;
-        for (int ch = 0; ch < 3; ++ch) {
-          float* c0 = field.plane(ch, 0);
-          const float c[3] = {field.plane(ch, 1)[i], field.plane(ch, 2)[i], field.plane(ch, 3)[i]};
-          const float power = c0[i] * sh::kFluxPerC0;
-          const float raw = power > 0.0f ? clampedFaceFlux(c0[i], c) : 0.0f;
+    for (int y = 1; y < f.dims.y - 1; ++y) {
+      if (!factors.rowActive[std::size_t(z) * f.dims.y + y]) continue;
+      const std::size_t start = f.index(0, y, z);
+      for (int ch = 0; ch < 3; ++ch) {
+        float* __restrict c0 = field.plane(ch, 0) + start;
+        float* __restrict cx = field.plane(ch, 1) + start;
+        float* __restrict cy = field.plane(ch, 2) + start;
+        float* __restrict cz = field.plane(ch, 3) + start;
+        float emitted = 0.0f, removed = 0.0f;
+#pragma omp simd reduction(+ : emitted, removed)
+        for (int x = 0; x < f.dims.x; ++x) {
+          const float power = std::max(0.0f, c0[x] * sh::kFluxPerC0);
+          const float raw = clampedFaceFlux(c0[x], cx[x], cy[x], cz[x]);
           const float scale = raw > 0.0f ? power / raw : 0.0f;
-          for (int k = 0; k < 4; ++k) field.plane(ch, k)[i] *= scale;
-          s.emitted[ch] += std::max(0.0f, power);
-          s.clampRemoved[ch] += std::max(0.0f, raw - power);
+          c0[x] *= scale;
+          cx[x] *= scale;
+          cy[x] *= scale;
+          cz[x] *= scale;
+          emitted += power;
+          removed += std::max(0.0f, raw - power);
         }
+        s.emitted[ch] += emitted;
+        s.clampRemoved[ch] += removed;
       }
+    }
   });
 }
 
+struct Gathered {
+  float c0 = 0.0f, c[3] = {0.0f, 0.0f, 0.0f};
+};
+
+/// Adds what the neighbour at `j` sends through the 5 faces of the destination when light
+/// travels along SD * e_A: the front face re-emits along e_A, the side faces along ±e_B.
+template <int A, int SD>
+inline void gatherFrom(const float* __restrict c0, const float* __restrict cx, const float* __restrict cy,
+                       const float* __restrict cz, std::size_t j, Gathered& out) {
+  constexpr int B1 = (A + 1) % 3, B2 = (A + 2) % 3;
+  const float c1[3] = {cx[j], cy[j], cz[j]};
+  const float base = c0[j] * sh::kY00;
+  const float along = (SD * sh::kY1) * c1[A];
+  const float front = std::max(0.0f, base + along);
+  const float alongSide = base + along * kSideNorm;
+  const float h1 = (0.5f * sh::kY1 * kSideNorm) * c1[B1];
+  const float h2 = (0.5f * sh::kY1 * kSideNorm) * c1[B2];
+  const float s1p = std::max(0.0f, alongSide + h1), s1m = std::max(0.0f, alongSide - h1);
+  const float s2p = std::max(0.0f, alongSide + h2), s2m = std::max(0.0f, alongSide - h2);
+  out.c0 += kEmitDC * (kFront * front + kSide * (s1p + s1m + s2p + s2m));
+  out.c[A] += float(SD) * kEmitLinear * kFront * front;
+  out.c[B1] += kEmitLinear * kSide * (s1p - s1m);
+  out.c[B2] += kEmitLinear * kSide * (s2p - s2m);
+}
+
 /// One gather into dst for the interior rows of slice z; applies the step factors,
-/// accumulates, and records the slice's power sums.
+/// accumulates, and records the slice's power sums. All six neighbours are read in one
+/// pass over the row so each output is written once.
 void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& dst, ShGrid& accumulated,
-                 std::vector<float>& acc, SliceSums& s) {
+                 SliceSums& s) {
   const GridFrame& f = src.frame;
-  const int row = f.dims.x - 2;
+  const std::size_t sx = 1, sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
   for (int y = 1; y < f.dims.y - 1; ++y) {
-    std::fill(acc.begin(), acc.end(), 0.0f);
+    // Inactive rows stay zero in both ping-pong buffers.
+    if (!factors.rowActive[std::size_t(z) * f.dims.y + y]) continue;
     const std::size_t rowStart = f.index(1, y, z);
-    for (int a = 0; a < 3; ++a) {
-      const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
-      for (int sd = -1; sd <= 1; sd += 2) {
-        // Light travelling along sd*e_a comes from the neighbour at -sd*e_a.
-        glm::ivec3 offset(0);
-        offset[a] = -sd;
-        const std::ptrdiff_t shift =
-            (std::ptrdiff_t(offset.z) * f.dims.y + offset.y) * f.dims.x + offset.x;
-        const std::size_t srcStart = std::size_t(std::ptrdiff_t(rowStart) + shift);
-        for (int ch = 0; ch < 3; ++ch) {
-          const float* __restrict c0 = src.plane(ch, 0) + srcStart;
-          const float* __restrict ca = src.plane(ch, 1 + a) + srcStart;
-          const float* __restrict cb1 = src.plane(ch, 1 + b1) + srcStart;
-          const float* __restrict cb2 = src.plane(ch, 1 + b2) + srcStart;
-          float* __restrict out0 = acc.data() + std::size_t(ch * 4) * row;
-          float* __restrict outA = acc.data() + std::size_t(ch * 4 + 1 + a) * row;
-          float* __restrict outB1 = acc.data() + std::size_t(ch * 4 + 1 + b1) * row;
-          float* __restrict outB2 = acc.data() + std::size_t(ch * 4 + 1 + b2) * row;
-          const float signedY1 = sd * sh::kY1;
-          for (int x = 0; x < row; ++x) {
-            const float base = c0[x] * sh::kY00;
-            const float along = signedY1 * ca[x];
-            const float front = std::max(0.0f, base + along);
-            const float alongSide = base + along * kSideNorm;
-            const float h1 = (0.5f * sh::kY1 * kSideNorm) * cb1[x];
-            const float h2 = (0.5f * sh::kY1 * kSideNorm) * cb2[x];
-            const float s1p = std::max(0.0f, alongSide + h1), s1m = std::max(0.0f, alongSide - h1);
-            const float s2p = std::max(0.0f, alongSide + h2), s2m = std::max(0.0f, alongSide - h2);
-            out0[x] += kEmitDC * (kFront * front + kSide * (s1p + s1m + s2p + s2m));
-            outA[x] += float(sd) * kEmitLinear * kFront * front;
-            outB1[x] += kEmitLinear * kSide * (s1p - s1m);
-            outB2[x] += kEmitLinear * kSide * (s2p - s2m);
-          }
-        }
-      }
-    }
+    const int row = f.dims.x - 2;
     for (int ch = 0; ch < 3; ++ch) {
-      const float* dc = factors.dc[ch].data() + rowStart;
-      const float* lin = factors.linear[ch].data() + rowStart;
-      const unsigned char* active = factors.active.data() + rowStart;
-      double gathered = 0.0, absorbed = 0.0, kept = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        const float* in = acc.data() + std::size_t(ch * 4 + k) * row;
-        float* out = dst.plane(ch, k) + rowStart;
-        float* sum = accumulated.plane(ch, k) + rowStart;
-        const float* factor = k == 0 ? dc : lin;
-        for (int x = 0; x < row; ++x) {
-          const float value = active[x] ? in[x] * factor[x] : 0.0f;
-          out[x] = value;
-          sum[x] += value;
-        }
-        if (k == 0)
-          for (int x = 0; x < row; ++x)
-            if (active[x]) {
-              gathered += in[x];
-              absorbed += in[x] * (1.0f - dc[x]);
-              kept += out[x];
-            }
+      const float* __restrict c0 = src.plane(ch, 0);
+      const float* __restrict cx = src.plane(ch, 1);
+      const float* __restrict cy = src.plane(ch, 2);
+      const float* __restrict cz = src.plane(ch, 3);
+      const float* __restrict dc = factors.dc[ch].data();
+      const float* __restrict lin = factors.linear[ch].data();
+      const unsigned char* __restrict active = factors.active.data();
+      float* __restrict out[4] = {dst.plane(ch, 0), dst.plane(ch, 1), dst.plane(ch, 2), dst.plane(ch, 3)};
+      float* __restrict sum[4] = {accumulated.plane(ch, 0), accumulated.plane(ch, 1), accumulated.plane(ch, 2),
+                                  accumulated.plane(ch, 3)};
+      float gathered = 0.0f, absorbed = 0.0f, kept = 0.0f;
+#pragma omp simd reduction(+ : gathered, absorbed, kept)
+      for (int x = 0; x < row; ++x) {
+        const std::size_t i = rowStart + x;
+        Gathered g;
+        gatherFrom<0, +1>(c0, cx, cy, cz, i - sx, g);
+        gatherFrom<0, -1>(c0, cx, cy, cz, i + sx, g);
+        gatherFrom<1, +1>(c0, cx, cy, cz, i - sy, g);
+        gatherFrom<1, -1>(c0, cx, cy, cz, i + sy, g);
+        gatherFrom<2, +1>(c0, cx, cy, cz, i - sz, g);
+        gatherFrom<2, -1>(c0, cx, cy, cz, i + sz, g);
+        const float on = active[i] ? 1.0f : 0.0f;
+        const float v0 = on * g.c0 * dc[i];
+        const float v1 = on * g.c[0] * lin[i], v2 = on * g.c[1] * lin[i], v3 = on * g.c[2] * lin[i];
+        out[0][i] = v0;
+        out[1][i] = v1;
+        out[2][i] = v2;
+        out[3][i] = v3;
+        sum[0][i] += v0;
+        sum[1][i] += v1;
+        sum[2][i] += v2;
+        sum[3][i] += v3;
+        gathered += on * g.c0;
+        absorbed += on * g.c0 * (1.0f - dc[i]);
+        kept += v0;
       }
-      s.gathered[ch] += gathered * sh::kFluxPerC0;
-      s.absorbed[ch] += absorbed * sh::kFluxPerC0;
-      s.inGrid[ch] += kept * sh::kFluxPerC0;
+      s.gathered[ch] += double(gathered) * sh::kFluxPerC0;
+      s.absorbed[ch] += double(absorbed) * sh::kFluxPerC0;
+      s.inGrid[ch] += double(kept) * sh::kFluxPerC0;
     }
   }
 }
@@ -179,6 +197,7 @@ StepFactors computeStepFactors(const MaterialGrid& material) {
     factors.linear[ch].assign(n, 0.0f);
   }
   factors.active.assign(n, 0);
+  factors.rowActive.assign(std::size_t(f.dims.y) * f.dims.z, 0);
   const double dx = f.cellSize;
   tbb::parallel_for(0, f.dims.z, [&](int z) {
     for (int y = 0; y < f.dims.y; ++y)
@@ -186,6 +205,7 @@ StepFactors computeStepFactors(const MaterialGrid& material) {
         const std::size_t i = f.index(x, y, z);
         if (!isActiveCell(material, x, y, z)) continue;
         factors.active[i] = 1;
+        factors.rowActive[std::size_t(z) * f.dims.y + y] = 1;
         for (int ch = 0; ch < 3; ++ch) {
           const double sigmaT = material.sigmaT[i][ch], sigmaS = material.sigmaS[i][ch];
           const double e = std::exp(-sigmaT * dx);
@@ -216,14 +236,12 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
   ShGrid next;
   next.resize(f);
   std::vector<SliceSums> sums(f.dims.z);
-  const std::size_t rowFloats = std::size_t(ShGrid::kPlanes) * (f.dims.x - 2);
   for (int step = 0; step < maxSteps; ++step) {
     std::fill(sums.begin(), sums.end(), SliceSums{});
     normalizeEmission(factors, field, sums);
     tbb::parallel_for(tbb::blocked_range<int>(1, f.dims.z - 1), [&](const tbb::blocked_range<int>& zs) {
       FlushDenormals flush;
-      std::vector<float> acc(rowFloats);
-      for (int z = zs.begin(); z < zs.end(); ++z) gatherSlice(z, factors, field, next, accumulated, acc, sums[z]);
+      for (int z = zs.begin(); z < zs.end(); ++z) gatherSlice(z, factors, field, next, accumulated, sums[z]);
     });
     std::swap(field.planes, next.planes);
     ++result.stepsRun;
