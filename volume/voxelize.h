@@ -10,4 +10,9 @@ namespace sslpv {
 /// Handles meshes of millions of triangles in seconds (OpenVDB meshToVolume, TBB).
 std::vector<float> voxelizeCoverage(const TriangleMesh& mesh, const GridFrame& frame);
 
+/// Exact fraction of a cube lying behind a plane with unit normal `normal` (pointing out
+/// of the solid) that passes at signed distance `distanceCells` from the cube's centre, in
+/// cell widths (negative: the centre is inside). The coverage rule voxelizeCoverage uses.
+double planeCubeCoverage(double distanceCells, glm::dvec3 normal);
+
 }  // namespace sslpv
