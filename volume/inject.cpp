@@ -19,8 +19,10 @@ int activeTrilinearWeights(const MaterialGrid& material, const glm::dvec3& p, st
     const glm::ivec3 c = base + glm::ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
     if (!f.contains(c.x, c.y, c.z) || !isActiveCell(material, c.x, c.y, c.z)) continue;
     const std::size_t index = f.index(c.x, c.y, c.z);
+    // Weighting by coverage makes a cell that barely touches the object fade in rather
+    // than switch on, which would show as contour rings across curved surfaces.
     const double w = (corner & 1 ? t.x : 1.0 - t.x) * (corner & 2 ? t.y : 1.0 - t.y) *
-                     (corner & 4 ? t.z : 1.0 - t.z);
+                     (corner & 4 ? t.z : 1.0 - t.z) * material.coverage[index];
     if (w <= 0.0) continue;
     cells[used] = index;
     weights[used] = float(w);

@@ -41,7 +41,7 @@ std::vector<SurfaceFluxSample> castShadowMap(const Light& light, const RayScene&
                                              ShadowMapStats* stats = nullptr);
 
 /// Trilinear weights of the 8 cells around world point p (continuous cell coordinates,
-/// cell centres at half-integers), restricted to cells with coverage > 0 and
+/// cell centres at half-integers) times each cell's coverage, restricted to active cells and
 /// renormalized. Returns the number of cells used (0: no active cell nearby).
 int activeTrilinearWeights(const MaterialGrid& material, const glm::dvec3& p,
                            std::size_t cells[8], float weights[8]);
