@@ -35,15 +35,30 @@ struct ValidationProblem {
 void initializeOpenVdb();
 
 /// Loads and validates; throws InputError with the first problem (file, grid, voxel).
+/// Missing, empty, truncated and corrupt files are InputErrors too: the file is parsed
+/// in an isolated child process (see volume/vdb_isolated_read.h). Metadata "units"
+/// missing means "mm"; any other value than mm, cm, m or in is an error.
 std::shared_ptr<const MaterialSet> loadMaterialSet(const std::filesystem::path& file);
 
-/// Every problem in `set` (σt < 0, σs < 0, σs > σt, |g| >= 1, NaN/Inf), each naming
-/// `fileForMessages`, the grid and the voxel. Stops after `maxProblems`.
+/// Every problem in `set` (a missing required grid, σt < 0, σs < 0, σs > σt, |g| >= 1,
+/// NaN/Inf), each naming `fileForMessages`, the grid and the voxel in index coordinates
+/// plus its world position through the grid's transform; active tiles are named as a
+/// tile at its origin. Stops after `maxProblems`.
+///
+/// Backgrounds are checked with the same rules although the field never reads them
+/// (inactive = base): other renderers read the raw grids, where the background is the
+/// value outside the active region, so an invalid one marks a broken file.
+/// σs <= σt (per channel, relative tolerance 1e-6 for float round-off) is checked only
+/// where both grids have an active value at the same index and the two grids share one
+/// transform: where one side is inactive the field takes the base material there, which
+/// the file alone does not know (the scene's base is checked by the scene loader).
 std::vector<ValidationProblem> validateMaterialSet(const MaterialSet& set,
                                                    const std::string& fileForMessages,
                                                    std::size_t maxProblems = 100);
 
-/// Writes the set atomically with metadata units/creator/version.
+/// Writes the set atomically with metadata units/creator/version ("version" is the
+/// material-set format version, an int, currently 1; creator defaults to "sslpv").
+/// Does not validate the values, so tests and tools can write invalid files on purpose.
 void saveMaterialSet(const MaterialSet& set, const std::filesystem::path& file);
 
 /// Human-readable report for `sslpv inspect`: grids, types, active voxel counts, value
@@ -62,6 +77,9 @@ class MaterialField {
   MaterialField(const MaterialSample& base, std::shared_ptr<const MaterialSet> set,
                 const glm::dmat4& worldToRest, double sigmaScale);
 
+  /// Holds ValueAccessors and scratch buffers: cheap to create (one allocation, no tree
+  /// traversal), one per thread. Copies share that state: do not use a Sampler and its
+  /// copy on two threads. Non-finite points and boxes give the base material.
   class Sampler {
    public:
     /// The field at a world point.
@@ -85,6 +103,10 @@ class MaterialField {
   std::shared_ptr<const MaterialSet> set_;
   glm::dmat4 worldToRest_;
   double sigmaScale_;
+  /// Per-grid maps from world to index space and active bounding boxes, computed once
+  /// here so that making a Sampler costs no tree traversal.
+  struct Prepared;
+  std::shared_ptr<const Prepared> prepared_;
 };
 
 /// Fills material.sigmaT/sigmaS/g for every cell of `material.frame` with the field
