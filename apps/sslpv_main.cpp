@@ -7,6 +7,7 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "volume/atomic_file.h"
 #include "volume/cpu_renderer.h"
@@ -106,6 +107,11 @@ int main(int argc, char** argv) {
   std::string inspectFile;
   CLI::App* inspectCmd = app.add_subcommand("inspect", "Report the grids of a VDB material set and validate it");
   inspectCmd->add_option("file", inspectFile, "VDB file")->required();
+
+  // CLI11 reports a stray subcommand only as "extra arguments"; name it instead.
+  if (argc > 1 && argv[1][0] != '-' && std::string_view(argv[1]) != "render" &&
+      std::string_view(argv[1]) != "inspect")
+    return fail(kExitInput, std::string("unknown subcommand '") + argv[1] + "' (expected render or inspect)");
 
   try {
     app.parse(argc, argv);
