@@ -1,0 +1,309 @@
+// GPU propagation against the CPU reference sslpv::propagate(): same field, same
+// accumulated light, same steps and the same per-step energy bookkeeping.
+//
+// Tolerances: the GPU sums in float in a different order (and may fuse multiply-adds),
+// so values are compared with max |gpu - cpu| <= 1e-4 * max |cpu| over the whole grid,
+// checked plane by plane; per-step powers with |gpu - cpu| <= 1e-4 * injected power.
+#include "gpu/gpu_propagation.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "gpu_test_fixture.h"
+#include "lpv_test_grids.h"
+#include "volume/error.h"
+
+namespace {
+using namespace sslpv;
+using namespace sslpv::test;
+
+constexpr double kValueTolerance = 1e-4;
+constexpr double kPowerTolerance = 1e-4;
+
+struct Outcome {
+  ShGrid field, accumulated;
+  PropagationResult result;
+};
+
+Outcome runCpu(const MaterialGrid& material, const ShGrid& injected, const PropagationOptions& options) {
+  Outcome run;
+  run.field = injected;
+  run.accumulated.resize(material.frame);
+  run.result = propagate(material, computeStepFactors(material), run.field, run.accumulated, options);
+  return run;
+}
+
+Outcome runGpu(const gpu::VulkanDevice& device, const MaterialGrid& material, const ShGrid& injected,
+               const PropagationOptions& options, const gpu::GpuPropagatorOptions& gpuOptions = {}) {
+  Outcome run;
+  run.field = injected;
+  run.accumulated.resize(material.frame);
+  gpu::GpuPropagator propagator(device, material.frame, computeStepFactors(material), gpuOptions);
+  run.result = propagator.run(run.field, run.accumulated, options);
+  return run;
+}
+
+double maxAbs(const ShGrid& grid) {
+  double m = 0.0;
+  for (const std::vector<float>& plane : grid.planes)
+    for (float v : plane) m = std::max(m, double(std::fabs(v)));
+  return m;
+}
+
+void expectGridsMatch(const ShGrid& gpu, const ShGrid& cpu, const std::string& what) {
+  const double tolerance = kValueTolerance * maxAbs(cpu);
+  for (int k = 0; k < ShGrid::kPlanes; ++k) {
+    double worst = 0.0;
+    std::size_t worstCell = 0;
+    for (std::size_t i = 0; i < cpu.planes[k].size(); ++i) {
+      const double d = std::fabs(double(gpu.planes[k][i]) - cpu.planes[k][i]);
+      if (d > worst) worst = d, worstCell = i;
+    }
+    EXPECT_LE(worst, tolerance) << what << " plane " << k << " cell " << worstCell << ": gpu "
+                                << gpu.planes[k][worstCell] << " cpu " << cpu.planes[k][worstCell];
+  }
+}
+
+void expectEnergyMatches(const PropagationResult& gpu, const PropagationResult& cpu, const std::string& what) {
+  ASSERT_EQ(gpu.stepsRun, cpu.stepsRun) << what;
+  ASSERT_EQ(gpu.energy.size(), cpu.energy.size()) << what;
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_NEAR(gpu.initialPower[ch], cpu.initialPower[ch], 1e-9 * cpu.initialPower[ch]) << what;
+    const double tolerance = kPowerTolerance * cpu.initialPower[ch];
+    for (std::size_t s = 0; s < cpu.energy.size(); ++s) {
+      const StepEnergy &g = gpu.energy[s], &c = cpu.energy[s];
+      EXPECT_NEAR(g.inGrid[ch], c.inGrid[ch], tolerance) << what << " step " << s << " channel " << ch;
+      EXPECT_NEAR(g.left[ch], c.left[ch], tolerance) << what << " step " << s << " channel " << ch;
+      EXPECT_NEAR(g.absorbed[ch], c.absorbed[ch], tolerance) << what << " step " << s << " channel " << ch;
+      EXPECT_NEAR(g.clampRemoved[ch], c.clampRemoved[ch], tolerance) << what << " step " << s << " channel " << ch;
+    }
+  }
+}
+
+void expectRunsMatch(const Outcome& gpu, const Outcome& cpu, const std::string& what) {
+  expectEnergyMatches(gpu.result, cpu.result, what);
+  expectGridsMatch(gpu.accumulated, cpu.accumulated, what + " accumulated");
+  expectGridsMatch(gpu.field, cpu.field, what + " last field");
+}
+
+PropagationOptions stepsWithEnergy(int steps) {
+  PropagationOptions options;
+  options.steps = steps;
+  options.recordEnergy = true;
+  return options;
+}
+
+using GpuPropagation = GpuTest;
+
+TEST_F(GpuPropagation, UniformGridLobeMatchesCpuFor1_8_40Steps) {
+  const MaterialGrid material = uniformMaterial(16, glm::vec3(0.8f, 1.0f, 1.5f), glm::vec3(0.7f, 0.9f, 0.6f), 0.3f);
+  ShGrid injected;
+  injected.resize(material.frame);
+  putLobe(injected, 8, 8, 8, glm::normalize(glm::vec3(1, 2, 3)), 1.0f);
+  for (int steps : {1, 8, 40}) {
+    const PropagationOptions options = stepsWithEnergy(steps);
+    expectRunsMatch(runGpu(device(), material, injected, options), runCpu(material, injected, options),
+                    std::to_string(steps) + " steps");
+  }
+}
+
+/// A random box of 5..20 cells per axis: random coverage with holes, σt from 0 to dense,
+/// albedo up to exactly 1, g up to ±0.999, and cosine lobes in random active cells.
+struct RandomCase {
+  MaterialGrid material;
+  ShGrid injected;
+};
+
+RandomCase randomCase(std::mt19937& rng) {
+  std::uniform_int_distribution<int> dim(5, 20);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  RandomCase c;
+  MaterialGrid& m = c.material;
+  m.frame.cellSize = 0.1 + unit(rng);
+  m.frame.dims = glm::ivec3(dim(rng), dim(rng), dim(rng));
+  const std::size_t n = m.frame.cellCount();
+  const float holes = 0.4f * unit(rng);
+  m.coverage.resize(n);
+  m.sigmaT.resize(n);
+  m.sigmaS.resize(n);
+  m.g.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    m.coverage[i] = unit(rng) < holes ? 0.0f : std::max(1e-3f, unit(rng));
+    for (int ch = 0; ch < 3; ++ch) {
+      const float pick = unit(rng);
+      const float sigmaT = pick < 0.1f ? 0.0f : std::exp(8.0f * unit(rng) - 4.0f);  // 0, or 0.02 .. 55
+      const float albedo = pick > 0.7f ? 1.0f : unit(rng);
+      m.sigmaT[i][ch] = sigmaT;
+      m.sigmaS[i][ch] = albedo * sigmaT;
+    }
+    const float gPick = unit(rng);
+    m.g[i] = gPick < 0.15f ? 0.999f : gPick < 0.3f ? -0.999f : 2.0f * unit(rng) - 1.0f;
+  }
+  c.injected.resize(m.frame);
+  const int lobes = 1 + int(unit(rng) * 6);
+  for (int placed = 0, tries = 0; placed < lobes && tries < 1000; ++tries) {
+    const int x = int(unit(rng) * m.frame.dims.x), y = int(unit(rng) * m.frame.dims.y),
+              z = int(unit(rng) * m.frame.dims.z);
+    if (!m.frame.contains(x, y, z) || !isActiveCell(m, x, y, z)) continue;  // injection's contract
+    glm::vec3 dir(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f);
+    if (glm::length(dir) < 1e-3f) continue;
+    putLobe(c.injected, x, y, z, glm::normalize(dir), 0.1f + 10.0f * unit(rng));
+    ++placed;
+  }
+  return c;
+}
+
+TEST_F(GpuPropagation, RandomGridsMatchCpuFor1_8_40Steps) {
+  std::mt19937 rng(20240611);
+  for (int k = 0; k < 8; ++k) {
+    const RandomCase c = randomCase(rng);
+    const glm::ivec3 d = c.material.frame.dims;
+    const std::string name = "case " + std::to_string(k) + " (" + std::to_string(d.x) + "x" + std::to_string(d.y) +
+                             "x" + std::to_string(d.z) + ")";
+    for (int steps : {1, 8, 40}) {
+      const PropagationOptions options = stepsWithEnergy(steps);
+      expectRunsMatch(runGpu(device(), c.material, c.injected, options), runCpu(c.material, c.injected, options),
+                      name + ", " + std::to_string(steps) + " steps");
+    }
+  }
+}
+
+TEST_F(GpuPropagation, WorkgroupShapesZChunksAndStagingGiveTheSameResult) {
+  // Results must not depend on how the grid is tiled (halo and chunk seams) or on how
+  // data reaches the device; 2 steps per submission also crosses submission boundaries.
+  std::mt19937 rng(7);
+  const RandomCase c = randomCase(rng);
+  const PropagationOptions options = stepsWithEnergy(9);
+  const Outcome cpu = runCpu(c.material, c.injected, options);
+  for (const auto& [gx, gy, zChunk, staging] : {std::tuple{8, 8, 3, false}, std::tuple{16, 16, 1, false},
+                                                std::tuple{4, 4, 5, true}, std::tuple{32, 8, 0, true}}) {
+    gpu::GpuPropagatorOptions gpuOptions;
+    gpuOptions.groupX = gx;
+    gpuOptions.groupY = gy;
+    gpuOptions.zChunk = zChunk;
+    gpuOptions.forceStaging = staging;
+    gpuOptions.stepsPerSubmission = 2;
+    expectRunsMatch(runGpu(device(), c.material, c.injected, options, gpuOptions), cpu,
+                    std::to_string(gx) + "x" + std::to_string(gy) + " z" + std::to_string(zChunk) +
+                        (staging ? " staged" : " mapped"));
+  }
+}
+
+TEST_F(GpuPropagation, IsotropicFieldIsConserved) {
+  // Transparent medium filled with the same isotropic intensity: every interior cell
+  // receives exactly what it sends, so cells away from the boundary do not change.
+  const MaterialGrid material = uniformMaterial(10, glm::vec3(0.0f), glm::vec3(0.0f), 0.0f);
+  const StepFactors factors = computeStepFactors(material);
+  ShGrid field, accumulated;
+  field.resize(material.frame);
+  accumulated.resize(material.frame);
+  for (std::size_t i = 0; i < material.frame.cellCount(); ++i)
+    if (factors.active[i])
+      for (int ch = 0; ch < 3; ++ch) field.plane(ch, 0)[i] = 1.0f;
+  gpu::GpuPropagator propagator(device(), material.frame, factors);
+  propagator.run(field, accumulated, stepsWithEnergy(1));
+  for (int z = 2; z < 8; ++z)
+    for (int y = 2; y < 8; ++y)
+      for (int x = 2; x < 8; ++x) {
+        const std::size_t i = material.frame.index(x, y, z);
+        for (int ch = 0; ch < 3; ++ch) {
+          EXPECT_NEAR(field.plane(ch, 0)[i], 1.0f, 1e-6f) << x << "," << y << "," << z;
+          for (int k = 1; k < 4; ++k) EXPECT_NEAR(field.plane(ch, k)[i], 0.0f, 1e-6f);
+        }
+      }
+}
+
+TEST_F(GpuPropagation, EnergyBalanceClosesStepByStep) {
+  // Grid + left + absorbed = injected at every step, with absorption per channel; with
+  // albedo 1 in the first channel nothing of it is absorbed.
+  const MaterialGrid material = uniformMaterial(14, glm::vec3(1.0f), glm::vec3(1.0f, 0.8f, 0.5f), 0.2f);
+  ShGrid injected;
+  injected.resize(material.frame);
+  putLobe(injected, 7, 7, 7, glm::vec3(0, 0, 1), 1.0f);
+  const Outcome gpu = runGpu(device(), material, injected, stepsWithEnergy(40));
+  ASSERT_EQ(gpu.result.energy.size(), 40u);
+  glm::dvec3 left(0.0), absorbed(0.0);
+  for (std::size_t s = 0; s < gpu.result.energy.size(); ++s) {
+    const StepEnergy& e = gpu.result.energy[s];
+    left += e.left;
+    absorbed += e.absorbed;
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(e.inGrid[ch] + left[ch] + absorbed[ch], gpu.result.initialPower[ch],
+                  kPowerTolerance * gpu.result.initialPower[ch])
+          << "step " << s << " channel " << ch;
+    EXPECT_NEAR(e.absorbed.x, 0.0, 1e-6 * gpu.result.initialPower.x) << "albedo 1 absorbs nothing";
+  }
+  EXPECT_GT(left.x, 0.1 * gpu.result.initialPower.x) << "light reaches the boundary within 40 steps";
+  EXPECT_GT(absorbed.z, absorbed.y) << "the lowest albedo channel absorbs most";
+}
+
+TEST_F(GpuPropagation, AutoStepsStopAtTheSameStepAsTheCpu) {
+  const MaterialGrid material = uniformMaterial(16, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f);
+  ShGrid injected;
+  injected.resize(material.frame);
+  putLobe(injected, 8, 8, 8, glm::vec3(0, 1, 0), 1.0f);
+  PropagationOptions options = stepsWithEnergy(0);
+  options.autoSteps = true;
+  options.autoTolerance = 1e-3;
+  const Outcome cpu = runCpu(material, injected, options);
+  ASSERT_GT(cpu.result.stepsRun, 8) << "the case must need several submissions of 8 steps";
+  gpu::GpuPropagatorOptions gpuOptions;
+  gpuOptions.stepsPerSubmission = 8;  // the stop falls inside a submission
+  expectRunsMatch(runGpu(device(), material, injected, options, gpuOptions), cpu, "auto steps");
+}
+
+TEST_F(GpuPropagation, GridsTooSmallToPropagateOnlyAccumulateTheInjectedLight) {
+  const MaterialGrid material = uniformMaterial(2, glm::vec3(1.0f), glm::vec3(0.5f), 0.0f);
+  ShGrid injected;
+  injected.resize(material.frame);
+  putLobe(injected, 1, 1, 1, glm::vec3(1, 0, 0), 2.0f);
+  const PropagationOptions options = stepsWithEnergy(5);
+  const Outcome gpu = runGpu(device(), material, injected, options);
+  EXPECT_EQ(gpu.result.stepsRun, 0);
+  expectRunsMatch(gpu, runCpu(material, injected, options), "2x2x2 grid");
+}
+
+TEST_F(GpuPropagation, ReportsKernelTimesWhenTimestampsExist) {
+  const MaterialGrid material = uniformMaterial(12, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f);
+  ShGrid field, accumulated;
+  field.resize(material.frame);
+  accumulated.resize(material.frame);
+  putLobe(field, 6, 6, 6, glm::vec3(1, 0, 0), 1.0f);
+  gpu::GpuPropagator propagator(device(), material.frame, computeStepFactors(material));
+  propagator.run(field, accumulated, stepsWithEnergy(4));
+  EXPECT_EQ(propagator.timings().steps, 4);
+  if (device().timestampValidBits() == 0) GTEST_SKIP() << "SKIPPED, the queue has no timestamps";
+  EXPECT_GT(propagator.timings().propagateMs, 0.0);
+  EXPECT_GT(propagator.timings().reduceMs, 0.0);
+}
+
+TEST_F(GpuPropagation, GridBeyondTheStorageBufferRangeIsAResourceError) {
+  GridFrame frame;
+  frame.dims = glm::ivec3(256);
+  const std::uint64_t needed = std::uint64_t(frame.cellCount()) * 3 * 16;
+  if (needed <= device().properties().limits.maxStorageBufferRange)
+    GTEST_SKIP() << "SKIPPED, this device binds " << needed << " bytes in one buffer";
+  // The check comes before anything is allocated or uploaded, so no factors are needed.
+  try {
+    gpu::GpuPropagator propagator(device(), frame, StepFactors{});
+    FAIL() << "a 256^3 grid was accepted";
+  } catch (const ResourceError& e) {
+    EXPECT_NE(std::string(e.what()).find("256x256x256"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(GpuPropagation, MismatchedGridsAreRejected) {
+  const MaterialGrid material = uniformMaterial(6, glm::vec3(1.0f), glm::vec3(0.5f), 0.0f);
+  const MaterialGrid other = uniformMaterial(7, glm::vec3(1.0f), glm::vec3(0.5f), 0.0f);
+  EXPECT_THROW(gpu::GpuPropagator(device(), material.frame, computeStepFactors(other)), GpuError);
+  gpu::GpuPropagator propagator(device(), material.frame, computeStepFactors(material));
+  ShGrid field, accumulated;
+  field.resize(other.frame);
+  accumulated.resize(material.frame);
+  EXPECT_THROW(propagator.run(field, accumulated, stepsWithEnergy(1)), GpuError);
+}
+
+}  // namespace
