@@ -1,9 +1,7 @@
 #include "volume/cpu_renderer.h"
 
 #include <chrono>
-#include <cstdio>
 #include <glm/mat4x4.hpp>
-#include <sstream>
 
 #include "volume/error.h"
 #include "volume/material_set.h"
@@ -27,20 +25,13 @@ class Stopwatch {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-std::unique_ptr<MaterialField> makeMaterialField(const Scene& scene) {
-  std::shared_ptr<const MaterialSet> set;
-  double sigmaScale = 1.0;
-  if (scene.material.vdb) {
-    set = loadMaterialSet(*scene.material.vdb);
-    const auto fileUnit = unitInMm(set->units);
-    if (!fileUnit)
-      throw InputError(scene.material.vdb->string() + ": unknown units '" + set->units +
-                       "' in file metadata (expected mm, cm, m or in)");
-    // σ per file unit -> σ per scene unit.
-    sigmaScale = scene.unitInMm / *fileUnit;
-  }
-  return std::make_unique<MaterialField>(scene.material.base, set, glm::inverse(scene.transform.matrix()),
-                                         sigmaScale);
+/// σ per file unit -> σ per scene unit.
+double sigmaScaleOf(const Scene& scene, const MaterialSet& set) {
+  const auto fileUnit = unitInMm(set.units);
+  if (!fileUnit)
+    throw InputError(scene.material.vdb->string() + ": unknown units '" + set.units +
+                     "' in file metadata (expected mm, cm, m or in)");
+  return scene.unitInMm / *fileUnit;
 }
 
 }  // namespace
@@ -52,79 +43,118 @@ CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
   triangles_ = mesh_->triangles.size();
   bounds_ = mesh_->bounds();
   rays_ = std::make_unique<RayScene>(*mesh_);
-  field_ = makeMaterialField(scene);
+  if (scene.material.vdb) {
+    set_ = loadMaterialSet(*scene.material.vdb);
+    sigmaScale_ = sigmaScaleOf(scene, *set_);
+  }
+  field_ = std::make_unique<MaterialField>(scene.material.base, set_, glm::inverse(scene.transform.matrix()),
+                                           sigmaScale_);
   loadMs_ = watch.lapMs();
 }
 
 CpuRenderer::~CpuRenderer() = default;
 
-Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
-  RenderReport report;
-  report.times.load = loadMs_;
-  report.triangles = triangles_;
-  Stopwatch watch;
-
-  MaterialGrid material;
-  material.frame = makeGridFrame(bounds_, settings.resolution);
-  const GridFrame& frame = material.frame;
-  material.coverage = voxelizeCoverage(*mesh_, frame);
-  report.times.voxelize = watch.lapMs();
-  resampleMaterial(*field_, material);
-  const StepFactors factors = computeStepFactors(material);
-  report.times.resample = watch.lapMs();
-  for (unsigned char a : factors.active) report.activeCells += a;
-  report.frame = frame;
-
-  std::vector<SurfaceFluxSample> samples;
-  for (const Light& light : scene_.lights) {
-    ShadowMapStats stats;
-    auto lightSamples = castShadowMap(light, *rays_, bounds_, settings.shadowMap, scene_.material.ior, &stats);
-    samples.insert(samples.end(), lightSamples.begin(), lightSamples.end());
-    report.lights.push_back(stats);
-  }
-  report.times.shadowMap = watch.lapMs();
-
-  ShGrid field, accumulated;
-  field.resize(frame);
-  accumulated.resize(frame);
-  report.injection = injectSamples(samples, material, field);
-  report.times.injection = watch.lapMs();
-
-  PropagationOptions options;
-  options.steps = settings.steps;
-  options.autoSteps = settings.autoSteps;
-  report.propagation = propagate(material, factors, field, accumulated, options);
-  report.times.propagation = watch.lapMs();
-
-  Image image = shadeImage(scene_.camera, *rays_, material, accumulated, scene_.material.ior);
-  report.times.shading = watch.lapMs();
-  if (reportOut) *reportOut = std::move(report);
-  return image;
+void CpuRenderer::setCamera(const Camera& camera) {
+  scene_.camera = camera;
+  dirty_.cameraChanged();
 }
 
-std::string formatTimings(const RenderReport& r) {
-  char line[160];
-  std::ostringstream out;
-  const StageTimes& t = r.times;
-  std::snprintf(line, sizeof line, "grid %dx%dx%d (cell %.4g, %zu active cells), %d steps, %zu triangles\n",
-                r.frame.dims.x, r.frame.dims.y, r.frame.dims.z, r.frame.cellSize, r.activeCells,
-                r.propagation.stepsRun, r.triangles);
-  out << line;
-  out << "stage                 ms\n";
-  auto row = [&](const char* name, double ms) {
-    std::snprintf(line, sizeof line, "%-18s %9.2f\n", name, ms);
-    out << line;
-  };
-  row("shadow map", t.shadowMap);
-  row("injection", t.injection);
-  row("propagation", t.propagation);
-  row("shading", t.shading);
-  row("total", t.frame());
-  out << "setup (once per object or material edit)\n";
-  row("load", t.load);
-  row("voxelize", t.voxelize);
-  row("resample", t.resample);
-  return out.str();
+void CpuRenderer::setLights(const std::vector<Light>& lights) {
+  scene_.lights = lights;
+  dirty_.lightsChanged();
+}
+
+void CpuRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) {
+  set_ = std::move(set);
+  if (set_ && scene_.material.vdb) sigmaScale_ = sigmaScaleOf(scene_, *set_);
+  field_ = std::make_unique<MaterialField>(scene_.material.base, set_, glm::inverse(scene_.transform.matrix()),
+                                           sigmaScale_);
+  dirty_.materialChanged(touched);
+}
+
+Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
+  if (lastSettings_) dirty_.settingsChanged(*lastSettings_, settings);
+  lastSettings_ = settings;
+
+  RenderReport& report = last_;
+  report.backend = "cpu";
+  report.times = StageTimes{};
+  report.times.load = loadMs_;
+  report.triangles = triangles_;
+  report.resampledCells = 0;
+  Stopwatch watch;
+
+  if (dirty_.dirty(Stage::Voxelize)) {
+    material_ = MaterialGrid{};
+    material_.frame = makeGridFrame(bounds_, settings.resolution);
+    material_.coverage = voxelizeCoverage(*mesh_, material_.frame);
+    report.frame = material_.frame;
+    report.times.voxelize = watch.lapMs();
+  } else {
+    report.times.markCached(Stage::Voxelize);
+  }
+
+  if (dirty_.dirty(Stage::Resample)) {
+    if (dirty_.resampleRegion()) {
+      report.resampledCells = resampleMaterialRegion(*field_, material_, *dirty_.resampleRegion());
+    } else {
+      resampleMaterial(*field_, material_);
+      report.resampledCells = material_.frame.cellCount();
+    }
+    factors_ = computeStepFactors(material_);
+    report.activeCells = 0;
+    for (unsigned char a : factors_.active) report.activeCells += a;
+    report.times.resample = watch.lapMs();
+  } else {
+    report.times.markCached(Stage::Resample);
+  }
+
+  if (dirty_.dirty(Stage::ShadowMap)) {
+    samples_.clear();
+    report.lights.clear();
+    for (const Light& light : scene_.lights) {
+      ShadowMapStats stats;
+      auto lightSamples =
+          castShadowMap(light, *rays_, bounds_, settings.shadowMap, scene_.material.ior, &stats);
+      samples_.insert(samples_.end(), lightSamples.begin(), lightSamples.end());
+      report.lights.push_back(stats);
+    }
+    report.times.shadowMap = watch.lapMs();
+  } else {
+    report.times.markCached(Stage::ShadowMap);
+  }
+
+  if (dirty_.dirty(Stage::Injection)) {
+    injected_.resize(material_.frame);
+    report.injection = injectSamples(samples_, material_, injected_);
+    report.times.injection = watch.lapMs();
+  } else {
+    report.times.markCached(Stage::Injection);
+  }
+
+  if (dirty_.dirty(Stage::Propagation)) {
+    // Propagation consumes its source; the injected light is kept for the next re-run.
+    ShGrid field = injected_;
+    accumulated_.resize(material_.frame);
+    PropagationOptions options;
+    options.steps = settings.steps;
+    options.autoSteps = settings.autoSteps;
+    report.propagation = propagate(material_, factors_, field, accumulated_, options);
+    report.times.propagation = watch.lapMs();
+  } else {
+    report.times.markCached(Stage::Propagation);
+  }
+
+  if (dirty_.dirty(Stage::Shading)) {
+    image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior);
+    report.times.shading = watch.lapMs();
+  } else {
+    report.times.markCached(Stage::Shading);
+  }
+
+  dirty_.clear();
+  if (reportOut) *reportOut = report;
+  return image_;
 }
 
 }  // namespace sslpv

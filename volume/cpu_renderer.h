@@ -1,10 +1,12 @@
 #pragma once
 // The CPU SSLPV backend: owns the object (mesh, ray-casting structure, material field)
-// and renders frames stage by stage with per-stage timings.
+// and the results of every stage, so a frame re-runs only the stages whose inputs
+// changed (a camera move re-shades, a brush stroke re-resamples its region).
 #include <memory>
-#include <string>
+#include <optional>
 #include <vector>
 
+#include "volume/frame_report.h"
 #include "volume/image_io.h"
 #include "volume/lpv_stages.h"
 #include "volume/scene.h"
@@ -13,24 +15,7 @@ namespace sslpv {
 
 class RayScene;
 class MaterialField;
-
-/// Wall-clock milliseconds of each stage. Scene setup (load, voxelize, resample) is paid
-/// once per object or material edit; the rest once per frame.
-struct StageTimes {
-  double load = 0, voxelize = 0, resample = 0;
-  double shadowMap = 0, injection = 0, propagation = 0, shading = 0;
-  double frame() const { return shadowMap + injection + propagation + shading; }
-};
-
-struct RenderReport {
-  StageTimes times;
-  GridFrame frame;
-  std::size_t activeCells = 0;
-  std::size_t triangles = 0;
-  std::vector<ShadowMapStats> lights;
-  InjectionStats injection;
-  PropagationResult propagation;
-};
+class MaterialSet;
 
 class CpuRenderer {
  public:
@@ -41,8 +26,17 @@ class CpuRenderer {
   CpuRenderer(const CpuRenderer&) = delete;
   CpuRenderer& operator=(const CpuRenderer&) = delete;
 
-  /// Renders one frame with the given LPV settings (they override the scene's).
+  /// Renders one frame with the given LPV settings (they override the scene's),
+  /// re-running only what changed since the previous frame.
   Image render(const LpvSettings& settings, RenderReport* report = nullptr);
+
+  /// The next frame re-shades only. `camera` must be valid (as the scene loader checks).
+  void setCamera(const Camera& camera);
+  /// The next frame re-runs shadow maps onwards.
+  void setLights(const std::vector<Light>& lights);
+  /// A painted material set: the next frame re-resamples the cells overlapping
+  /// `touched` (world bounds; everything when absent) and re-propagates.
+  void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched);
 
   const Scene& scene() const { return scene_; }
 
@@ -51,13 +45,21 @@ class CpuRenderer {
   double loadMs_ = 0;
   std::size_t triangles_ = 0;
   Bounds bounds_;
-  std::unique_ptr<RayScene> rays_;
-  std::unique_ptr<MaterialField> field_;
   std::unique_ptr<TriangleMesh> mesh_;
-};
+  std::unique_ptr<RayScene> rays_;
+  std::shared_ptr<const MaterialSet> set_;
+  double sigmaScale_ = 1.0;
+  std::unique_ptr<MaterialField> field_;
 
-/// The seed-style timing table (shadow map, injection, propagation, shading, total, ms),
-/// followed by the setup stages and the grid that was used.
-std::string formatTimings(const RenderReport& report);
+  // Results kept between frames.
+  StageDirty dirty_;
+  std::optional<LpvSettings> lastSettings_;
+  MaterialGrid material_;
+  StepFactors factors_;
+  std::vector<SurfaceFluxSample> samples_;
+  ShGrid injected_, accumulated_;
+  RenderReport last_;
+  Image image_;
+};
 
 }  // namespace sslpv

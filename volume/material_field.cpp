@@ -405,24 +405,28 @@ MaterialSample MaterialField::Sampler::boxAverage(const glm::dvec3& worldMin, co
   return MaterialSample{glm::vec3(sigmaT), glm::vec3(sigmaS), float(g)};
 }
 
-void resampleMaterial(const MaterialField& field, MaterialGrid& material) {
+namespace {
+
+/// Box-filters the field over the cells [lo, hi) of `material` (arrays already sized).
+void resampleCells(const MaterialField& field, MaterialGrid& material, const glm::ivec3& lo, const glm::ivec3& hi) {
   const GridFrame frame = material.frame;
-  const std::size_t cells = frame.cellCount();
-  material.sigmaT.resize(cells);
-  material.sigmaS.resize(cells);
-  material.g.resize(cells);
   if (field.homogeneous()) {
     const MaterialSample& base = field.base();
-    std::fill(material.sigmaT.begin(), material.sigmaT.end(), base.sigmaT);
-    std::fill(material.sigmaS.begin(), material.sigmaS.end(), base.sigmaS);
-    std::fill(material.g.begin(), material.g.end(), base.g);
+    for (int z = lo.z; z < hi.z; ++z)
+      for (int y = lo.y; y < hi.y; ++y)
+        for (int x = lo.x; x < hi.x; ++x) {
+          const std::size_t index = frame.index(x, y, z);
+          material.sigmaT[index] = base.sigmaT;
+          material.sigmaS[index] = base.sigmaS;
+          material.g[index] = base.g;
+        }
     return;
   }
   // Blocks of cells rather than whole z-slabs: the voxels under an 8x8x8 block of cells
   // stay in cache while it is filled, where a slab walks through the whole grid before
   // returning to the same leaves for the next slab.
   constexpr int kBlock = 8;
-  const tbb::blocked_range3d<int> blocks(0, frame.dims.z, kBlock, 0, frame.dims.y, kBlock, 0, frame.dims.x, kBlock);
+  const tbb::blocked_range3d<int> blocks(lo.z, hi.z, kBlock, lo.y, hi.y, kBlock, lo.x, hi.x, kBlock);
   tbb::parallel_for(
       blocks,
       [&](const tbb::blocked_range3d<int>& block) {
@@ -439,6 +443,37 @@ void resampleMaterial(const MaterialField& field, MaterialGrid& material) {
             }
       },
       tbb::simple_partitioner());
+}
+
+}  // namespace
+
+void resampleMaterial(const MaterialField& field, MaterialGrid& material) {
+  const std::size_t cells = material.frame.cellCount();
+  material.sigmaT.resize(cells);
+  material.sigmaS.resize(cells);
+  material.g.resize(cells);
+  resampleCells(field, material, glm::ivec3(0), material.frame.dims);
+}
+
+std::size_t resampleMaterialRegion(const MaterialField& field, MaterialGrid& material, const Bounds& worldRegion) {
+  const GridFrame& frame = material.frame;
+  if (material.sigmaT.size() != frame.cellCount() || material.sigmaS.size() != frame.cellCount() ||
+      material.g.size() != frame.cellCount()) {
+    resampleMaterial(field, material);
+    return frame.cellCount();
+  }
+  if (worldRegion.empty()) return 0;
+  // Every cell whose box overlaps the region: its box average may have changed.
+  const glm::dvec3 gMin = frame.toGrid(worldRegion.min), gMax = frame.toGrid(worldRegion.max);
+  glm::ivec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = int(std::clamp(std::floor(gMin[a]), 0.0, double(frame.dims[a])));
+    hi[a] = int(std::clamp(std::floor(gMax[a]) + 1.0, 0.0, double(frame.dims[a])));
+    if (lo[a] >= hi[a]) return 0;
+  }
+  resampleCells(field, material, lo, hi);
+  const glm::ivec3 size = hi - lo;
+  return std::size_t(size.x) * std::size_t(size.y) * std::size_t(size.z);
 }
 
 }  // namespace sslpv

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "volume/material.h"
+#include "volume/mesh.h"
 
 namespace sslpv {
 
@@ -112,5 +113,10 @@ class MaterialField {
 /// Fills material.sigmaT/sigmaS/g for every cell of `material.frame` with the field
 /// box-filtered over the cell (TBB parallel). coverage is left as is.
 void resampleMaterial(const MaterialField& field, MaterialGrid& material);
+
+/// Re-resamples only the cells whose box overlaps `worldRegion` (a brush stroke's bounds)
+/// and returns how many cells that was; the whole grid when the material arrays are not
+/// yet sized to the frame. The result equals a full resampleMaterial() of the new field.
+std::size_t resampleMaterialRegion(const MaterialField& field, MaterialGrid& material, const Bounds& worldRegion);
 
 }  // namespace sslpv
