@@ -1,7 +1,6 @@
 #include "volume/cpu_renderer.h"
 
 #include <chrono>
-#include <glm/mat4x4.hpp>
 
 #include "volume/error.h"
 #include "volume/material_set.h"
@@ -25,31 +24,12 @@ class Stopwatch {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-/// σ per file unit -> σ per scene unit.
-double sigmaScaleOf(const Scene& scene, const MaterialSet& set) {
-  const auto fileUnit = unitInMm(set.units);
-  if (!fileUnit)
-    throw InputError(scene.material.vdb->string() + ": unknown units '" + set.units +
-                     "' in file metadata (expected mm, cm, m or in)");
-  return scene.unitInMm / *fileUnit;
-}
-
 }  // namespace
 
-CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
+CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene), object_(scene_) {
   Stopwatch watch;
-  mesh_ = std::make_unique<TriangleMesh>(loadMesh(scene.mesh, scene.transform));
-  requireClosedMesh(*mesh_);
-  triangles_ = mesh_->triangles.size();
-  bounds_ = mesh_->bounds();
-  rays_ = std::make_unique<RayScene>(*mesh_);
-  if (scene.material.vdb) {
-    set_ = loadMaterialSet(*scene.material.vdb);
-    sigmaScale_ = sigmaScaleOf(scene, *set_);
-  }
-  field_ = std::make_unique<MaterialField>(scene.material.base, set_, glm::inverse(scene.transform.matrix()),
-                                           sigmaScale_);
-  loadMs_ = watch.lapMs();
+  rays_ = std::make_unique<RayScene>(object_.mesh());
+  loadMs_ = object_.loadMs() + watch.lapMs();
 }
 
 CpuRenderer::~CpuRenderer() = default;
@@ -65,10 +45,7 @@ void CpuRenderer::setLights(const std::vector<Light>& lights) {
 }
 
 void CpuRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) {
-  set_ = std::move(set);
-  if (set_ && scene_.material.vdb) sigmaScale_ = sigmaScaleOf(scene_, *set_);
-  field_ = std::make_unique<MaterialField>(scene_.material.base, set_, glm::inverse(scene_.transform.matrix()),
-                                           sigmaScale_);
+  object_.setMaterialSet(std::move(set));
   dirty_.materialChanged(touched);
 }
 
@@ -80,14 +57,14 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
   report.backend = "cpu";
   report.times = StageTimes{};
   report.times.load = loadMs_;
-  report.triangles = triangles_;
+  report.triangles = object_.mesh().triangles.size();
   report.resampledCells = 0;
   Stopwatch watch;
 
   if (dirty_.dirty(Stage::Voxelize)) {
     material_ = MaterialGrid{};
-    material_.frame = makeGridFrame(bounds_, settings.resolution);
-    material_.coverage = voxelizeCoverage(*mesh_, material_.frame);
+    material_.frame = makeGridFrame(object_.bounds(), settings.resolution);
+    material_.coverage = voxelizeCoverage(object_.mesh(), material_.frame);
     report.frame = material_.frame;
     report.times.voxelize = watch.lapMs();
   } else {
@@ -96,9 +73,9 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::Resample)) {
     if (dirty_.resampleRegion()) {
-      report.resampledCells = resampleMaterialRegion(*field_, material_, *dirty_.resampleRegion());
+      report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion());
     } else {
-      resampleMaterial(*field_, material_);
+      resampleMaterial(object_.field(), material_);
       report.resampledCells = material_.frame.cellCount();
     }
     factors_ = computeStepFactors(material_);
@@ -115,7 +92,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     for (const Light& light : scene_.lights) {
       ShadowMapStats stats;
       auto lightSamples =
-          castShadowMap(light, *rays_, bounds_, settings.shadowMap, scene_.material.ior, &stats);
+          castShadowMap(light, *rays_, object_.bounds(), settings.shadowMap, scene_.material.ior, &stats);
       samples_.insert(samples_.end(), lightSamples.begin(), lightSamples.end());
       report.lights.push_back(stats);
     }

@@ -10,12 +10,11 @@
 #include "volume/image_io.h"
 #include "volume/lpv_stages.h"
 #include "volume/scene.h"
+#include "volume/scene_object.h"
 
 namespace sslpv {
 
 class RayScene;
-class MaterialField;
-class MaterialSet;
 
 class CpuRenderer {
  public:
@@ -43,13 +42,8 @@ class CpuRenderer {
  private:
   Scene scene_;
   double loadMs_ = 0;
-  std::size_t triangles_ = 0;
-  Bounds bounds_;
-  std::unique_ptr<TriangleMesh> mesh_;
+  SceneObject object_;
   std::unique_ptr<RayScene> rays_;
-  std::shared_ptr<const MaterialSet> set_;
-  double sigmaScale_ = 1.0;
-  std::unique_ptr<MaterialField> field_;
 
   // Results kept between frames.
   StageDirty dirty_;

@@ -1,0 +1,42 @@
+#pragma once
+// The object of a scene as every backend needs it: the closed mesh in world space and
+// its material field (base material + optional painted material set).
+#include <glm/mat4x4.hpp>
+#include <memory>
+#include <string>
+
+#include "volume/material_set.h"
+#include "volume/mesh.h"
+#include "volume/scene.h"
+
+namespace sslpv {
+
+class SceneObject {
+ public:
+  /// Loads the mesh (in world space, closed-ness checked) and the material set. Throws
+  /// InputError on bad input.
+  explicit SceneObject(const Scene& scene);
+
+  /// A painted material set in the scene's material.vdb units (nullptr: base only).
+  void setMaterialSet(std::shared_ptr<const MaterialSet> set);
+
+  const TriangleMesh& mesh() const { return mesh_; }
+  const Bounds& bounds() const { return bounds_; }
+  const MaterialField& field() const { return *field_; }
+  /// Milliseconds the constructor took (reported as the "load" stage).
+  double loadMs() const { return loadMs_; }
+
+ private:
+  // What the material field needs from the scene (copied: the object outlives no scene).
+  MaterialSample base_;
+  std::string vdbName_;
+  double unitInMm_;
+  glm::dmat4 worldToRest_;
+  TriangleMesh mesh_;
+  Bounds bounds_;
+  std::shared_ptr<const MaterialSet> set_;
+  std::unique_ptr<MaterialField> field_;
+  double loadMs_ = 0.0;
+};
+
+}  // namespace sslpv
