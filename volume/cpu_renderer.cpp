@@ -6,7 +6,7 @@
 #include "volume/material_set.h"
 #include "volume/mesh.h"
 #include "volume/ray_scene.h"
-#include "volume/voxelize.h"
+#include "volume/voxelize_parity.h"
 
 namespace sslpv {
 namespace {
@@ -50,6 +50,7 @@ void CpuRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, const s
 }
 
 Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
+  Stopwatch frameWatch;
   if (lastSettings_) dirty_.settingsChanged(*lastSettings_, settings);
   lastSettings_ = settings;
 
@@ -64,7 +65,8 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
   if (dirty_.dirty(Stage::Voxelize)) {
     material_ = MaterialGrid{};
     material_.frame = makeGridFrame(object_.bounds(), settings.resolution);
-    material_.coverage = voxelizeCoverage(object_.mesh(), material_.frame);
+    // The twin of the GPU voxelizer, so both backends see the same occupancy.
+    material_.coverage = voxelizeCoverageParity(object_.mesh(), material_.frame);
     report.frame = material_.frame;
     report.times.voxelize = watch.lapMs();
   } else {
@@ -130,6 +132,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
   }
 
   dirty_.clear();
+  report.wallMs = frameWatch.lapMs();
   if (reportOut) *reportOut = report;
   return image_;
 }

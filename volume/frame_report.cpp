@@ -52,6 +52,7 @@ std::string formatTimings(const RenderReport& r) {
   row("propagation", t.propagation, t.cached(Stage::Propagation));
   row("shading", t.shading, t.cached(Stage::Shading));
   row("total", t.frame(), false);
+  if (r.wallMs > 0.0) row("frame wall clock", r.wallMs, false);
   out << "setup (once per object or material edit)\n";
   row("load", t.load, false);
   row("voxelize", t.voxelize, t.cached(Stage::Voxelize));

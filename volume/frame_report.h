@@ -34,6 +34,9 @@ struct RenderReport {
   std::size_t activeCells = 0;
   std::size_t triangles = 0;
   std::size_t resampledCells = 0;  ///< cells resampled this frame (0 when cached)
+  /// Wall-clock milliseconds of the whole frame as the caller saw it, submissions and
+  /// read-backs included (the stage rows of the GPU backend are device times).
+  double wallMs = 0.0;
   std::vector<ShadowMapStats> lights;
   InjectionStats injection;
   PropagationResult propagation;
