@@ -105,6 +105,15 @@ std::optional<std::uint32_t> computeQueueFamily(VkPhysicalDevice device, std::ui
   return best;
 }
 
+bool hasDeviceExtension(VkPhysicalDevice device, const char* name) {
+  std::uint32_t count = 0;
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkExtensionProperties> extensions(count);
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, extensions.data()) != VK_SUCCESS) return false;
+  return std::any_of(extensions.begin(), extensions.end(),
+                     [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
 std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
   std::uint32_t count = 0;
   SSLPV_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
@@ -163,7 +172,8 @@ void VulkanDevice::createInstance(bool validation) {
   app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
   app.pApplicationName = "sslpv";
   app.pEngineName = "sslpv";
-  app.apiVersion = VK_API_VERSION_1_2;
+  // 1.3 where the device has it: the raster passes use dynamic rendering (core in 1.3).
+  app.apiVersion = VK_API_VERSION_1_3;
   // Headless: no surface extensions; windows create their own instance extensions later.
   std::vector<const char*> extensions, layers;
   if (validation) {
@@ -244,10 +254,36 @@ void VulkanDevice::createDevice() {
   queueInfo.queueFamilyIndex = queueFamily_;
   queueInfo.queueCount = 1;
   queueInfo.pQueuePriorities = &priority;
+  // Float atomics let GPU injection add overlapping lobes from many samples; enabled
+  // wherever offered, and GpuInjector refuses a device without them.
+  std::vector<const char*> extensions;
+  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT atomicFloat{};
+  atomicFloat.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT;
+  if (hasDeviceExtension(physicalDevice_, VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME)) {
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.pNext = &atomicFloat;
+    vkGetPhysicalDeviceFeatures2(physicalDevice_, &features);
+    bufferFloatAtomicAdd_ = atomicFloat.shaderBufferFloat32AtomicAdd == VK_TRUE;
+  }
+  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT enabledAtomicFloat{};
+  enabledAtomicFloat.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT;
+  enabledAtomicFloat.shaderBufferFloat32AtomicAdd = VK_TRUE;
+  if (bufferFloatAtomicAdd_) extensions.push_back(VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
+
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  info.pNext = bufferFloatAtomicAdd_ ? &enabledAtomicFloat : nullptr;
+  // Dynamic rendering (core, and required of every Vulkan 1.3 device) for the raster passes.
+  VkPhysicalDeviceVulkan13Features features13{};
+  features13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+  features13.pNext = const_cast<void*>(info.pNext);
+  features13.dynamicRendering = VK_TRUE;
+  if (properties_.apiVersion >= VK_API_VERSION_1_3) info.pNext = &features13;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queueInfo;
+  info.enabledExtensionCount = std::uint32_t(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
   SSLPV_VK_CHECK(vkCreateDevice(physicalDevice_, &info, nullptr, &device_));
   vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 }

@@ -71,6 +71,9 @@ class VulkanDevice {
   /// timestamps unsupported).
   double timestampPeriodNs() const { return properties_.limits.timestampPeriod; }
   std::uint32_t timestampValidBits() const { return timestampValidBits_; }
+  /// shaderBufferFloat32AtomicAdd (VK_EXT_shader_atomic_float) is enabled: float
+  /// atomicAdd on storage buffers, which GPU injection needs. Enabled wherever offered.
+  bool bufferFloatAtomicAdd() const { return bufferFloatAtomicAdd_; }
 
   bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
   /// Warnings and errors reported by validation since the instance was created.
@@ -97,6 +100,7 @@ class VulkanDevice {
   VkPhysicalDeviceMemoryProperties memoryProperties_{};
   std::uint32_t queueFamily_ = 0;
   std::uint32_t timestampValidBits_ = 0;
+  bool bufferFloatAtomicAdd_ = false;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   mutable std::mutex queueMutex_;

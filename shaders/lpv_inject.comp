@@ -1,0 +1,78 @@
+#version 460
+// Injection: the twin of sslpv::injectSamples (volume/inject.cpp). Each GpuFluxSample
+// that hit the object adds a clamped cosine lobe holding flux/π about its refracted
+// direction, half a cell inside the surface (a full cell deeper when no active cell is
+// near), spread over active cells with activeTrilinearWeights. Neighbouring samples
+// write the same cells, so the lobes are added with float atomics. Each workgroup also
+// sums the injected and dropped flux of its samples into one row of partial sums, which
+// the host adds in double.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_atomic_float : require
+
+#include "volume/lpv_constants.h"
+#include "shaders/flux_sample_shared.h"
+#include "shaders/cell_coverage_shared.h"
+
+layout(local_size_x = SSLPV_INJECT_GROUP) in;
+
+layout(push_constant) uniform PushBlock { SSLPV_INJECT_PUSH_FIELDS(SSLPV_CC_DECLARE_FIELD) } push;
+
+layout(std430, binding = 0) readonly buffer Samples { GpuFluxSample samples[]; };
+#define SSLPV_CELL_COVERAGE_BINDING 1
+#include "shaders/cell_coverage.glsl"
+// The light field in GpuPropagator's layout: per cell 3 vec4 (one per channel: c0, c1x,
+// c1y, c1z), as 12 floats so that each coefficient can be added atomically.
+layout(std430, binding = 2) buffer Field { float field[]; };
+layout(std430, binding = 3) writeonly buffer Stats { vec4 partials[]; };
+
+shared vec4 injectedSums[SSLPV_INJECT_GROUP];
+shared vec4 droppedSums[SSLPV_INJECT_GROUP];
+
+void main() {
+  const CellGrid grid = SSLPV_CELL_GRID_FROM(push);
+  const float halfCell = 0.5 * grid.cellSize;
+  vec3 injected = vec3(0.0), dropped = vec3(0.0);
+  // A bounded number of workgroups strides over the samples, so the partial-sum rows
+  // (one per workgroup) have a fixed size whatever the sample count.
+  const uint stride = gl_NumWorkGroups.x * SSLPV_INJECT_GROUP;
+  for (uint s = gl_GlobalInvocationID.x; s < push.sampleCount; s += stride) {
+    const GpuFluxSample rec = samples[s];
+    if (rec.positionValid.w == 0.0) continue;  // the texel's ray missed the object
+    const vec3 p = rec.positionValid.xyz, n = rec.normal.xyz;
+    uint cells[8];
+    float weights[8];
+    int used = activeTrilinearWeights(grid, p - halfCell * n, cells, weights);
+    // Thin features: look a full cell deeper before giving up on the sample.
+    if (used == 0) used = activeTrilinearWeights(grid, p - grid.cellSize * n, cells, weights);
+    if (used == 0) {
+      dropped += rec.flux.rgb;
+      continue;
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+      // A Lambertian emitter of power Φ has intensity (Φ/π) max(0, cos).
+      const vec4 lobe = vec4(float(SSLPV_COSINE_LOBE_C0), float(SSLPV_COSINE_LOBE_C1) * rec.direction.xyz) *
+                        (rec.flux[ch] / float(SSLPV_PI));
+      for (int i = 0; i < used; ++i) {
+        const uint base = 12u * cells[i] + 4u * uint(ch);
+        for (int k = 0; k < 4; ++k) atomicAdd(field[base + uint(k)], weights[i] * lobe[k]);
+      }
+    }
+    injected += rec.flux.rgb;
+  }
+
+  const uint li = gl_LocalInvocationIndex;
+  injectedSums[li] = vec4(injected, 0.0);
+  droppedSums[li] = vec4(dropped, 0.0);
+  barrier();
+  for (uint half_ = SSLPV_INJECT_GROUP / 2; half_ > 0; half_ >>= 1) {
+    if (li < half_) {
+      injectedSums[li] += injectedSums[li + half_];
+      droppedSums[li] += droppedSums[li + half_];
+    }
+    barrier();
+  }
+  if (li == 0) {
+    partials[SSLPV_INJECT_STATS_VEC4 * gl_WorkGroupID.x] = injectedSums[0];
+    partials[SSLPV_INJECT_STATS_VEC4 * gl_WorkGroupID.x + 1] = droppedSums[0];
+  }
+}
