@@ -1,0 +1,75 @@
+#version 460
+// Shadow-map resolve, the GPU twin of the per-hit work of sslpv::castShadowMap
+// (volume/shadow_map.cpp): per texel of every view, the texel ray (ShadowView::texelRay),
+// its hit on the triangle the rasterizer found there, the outward geometric normal, the
+// light arriving (I dω or E dA, nothing outside a spot's cone), Fresnel transmittance and
+// the refracted direction, written as one GpuFluxSample (misses: all zero).
+#extension GL_GOOGLE_include_directive : require
+#include "shaders/flux_sample_shared.h"
+#include "shaders/fresnel.glsl"
+#include "shaders/shadow_map_shared.h"
+
+layout(local_size_x = SSLPV_SHADOW_RESOLVE_GROUP, local_size_y = SSLPV_SHADOW_RESOLVE_GROUP) in;
+
+layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Indices { uint indices[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Views { GpuShadowView views[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Triangles { uint triangles[]; };  // 1-based, 0 = none
+layout(std430, set = 0, binding = 4) writeonly buffer Samples { GpuFluxSample samples[]; };
+
+void main() {
+  const GpuShadowView view = views[gl_WorkGroupID.z];
+  const uint size = view.texels.x;
+  const uvec2 texel = gl_GlobalInvocationID.xy;
+  if (texel.x >= size || texel.y >= size) return;
+  const uint index = view.texels.y + texel.y * size + texel.x;
+
+  GpuFluxSample s;
+  s.positionValid = vec4(0.0);
+  s.normal = vec4(0.0);
+  s.direction = vec4(0.0);
+  s.flux = vec4(0.0);
+  const uint id = triangles[index];
+  if (id != 0u) {
+    // The texel ray, as ShadowView::texelRay computes it.
+    vec3 origin = view.origin.xyz, dir;
+    float weight;
+    if (view.origin.w == SSLPV_SHADOW_PERSPECTIVE) {
+      const float tanHalf = view.forward.w;
+      const float u = (2.0 * (float(texel.x) + 0.5) / float(size) - 1.0) * tanHalf;
+      const float v = (2.0 * (float(texel.y) + 0.5) / float(size) - 1.0) * tanHalf;
+      const vec3 d = view.forward.xyz + u * view.right.xyz + v * view.up.xyz;
+      const float len = length(d);
+      const float cosTheta = 1.0 / len;
+      dir = d / len;
+      weight = view.right.w * cosTheta * cosTheta * cosTheta;
+    } else {
+      const float side = view.right.w, halfSize = view.forward.w;
+      const float u = (float(texel.x) + 0.5) * side - halfSize, v = (float(texel.y) + 0.5) * side - halfSize;
+      origin += u * view.right.xyz + v * view.up.xyz;
+      dir = view.forward.xyz;
+      weight = side * side;
+    }
+    const uint triangle = id - 1u;
+    const vec3 v0 = positions[indices[3u * triangle]].xyz;
+    const vec3 v1 = positions[indices[3u * triangle + 1u]].xyz;
+    const vec3 v2 = positions[indices[3u * triangle + 2u]].xyz;
+    // Embree's geometric normal, (v1 - v0) x (v2 - v0): outward for counter-clockwise
+    // triangles seen from outside (RayHit::normal).
+    const vec3 ng = cross(v1 - v0, v2 - v0);
+    const vec3 n = normalize(ng);
+    const float cosI = -dot(dir, n);
+    // Grazing or from inside: no light enters here (also rejects degenerate triangles).
+    const vec3 power = dot(dir, view.coneAxis.xyz) < view.power.w ? vec3(0.0) : view.power.rgb * weight;
+    if (cosI > 0.0 && power != vec3(0.0)) {
+      const float t = dot(v0 - origin, ng) / dot(dir, ng);
+      const float eta = view.coneAxis.w;
+      const float transmittance = 1.0 - fresnelReflectance(cosI, eta);
+      s.positionValid = vec4(origin + t * dir, 1.0);
+      s.normal = vec4(n, 0.0);
+      s.direction = vec4(refractInto(dir, n, eta), 0.0);
+      s.flux = vec4(power * transmittance, 0.0);
+    }
+  }
+  samples[index] = s;
+}

@@ -1,0 +1,204 @@
+// GPU shading (rasterization) against the CPU reference sslpv::shadeImage: the same
+// accumulated light field (built on the CPU with the stage functions: voxelize, shadow
+// maps, injection, propagation) and material, shaded by both, compared pixel by pixel.
+//
+// Pixel classes: a pixel is background in an image when all its channels are exactly 0;
+// a silhouette pixel is one whose 3x3 neighbourhood holds a background pixel in either
+// image (coverage at the pixel centre is decided in fixed point by the rasterizer and in
+// float by the ray caster, so the outline may move by one pixel); object pixels are the
+// non-background pixels of the CPU image. Which triangle each pixel shows is known on
+// both sides (RayHit::triangle of the CPU's camera ray, GpuShader::readTriangles): an
+// edge pixel is one where both see a surface but not the same triangle, which happens
+// where the pixel centre lies within the rasterizer's vertex snapping (1/256 pixel on
+// llvmpipe) of an edge two triangles share; across a box's crease the two normals differ
+// by 90°, so such a pixel's radiance differs completely.
+// Expectations:
+// - background identical: a pixel whose whole 3x3 neighbourhood is background in one
+//   image is exactly 0 in the other, and the surface (triangle id 0 or not) agrees
+//   everywhere except at silhouette pixels;
+// - edge pixels: at most 1 % of the object pixels (the expected share is the snapping
+//   band times the edge length per pixel, about 0.1 % for triangles of ~3 pixels);
+// - every other non-silhouette object pixel: per channel |gpu - cpu| <= 2 % of cpu (both
+//   read the same cells with float instead of double weights; typical differences are
+//   1e-5);
+// - mean relative difference over all object pixels (silhouettes and edges included)
+//   <= 1 %.
+#include "gpu/gpu_shade.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <glm/trigonometric.hpp>
+#include <iostream>
+
+#include "gpu/gpu_inject.h"
+#include "gpu_test_fixture.h"
+#include "image_agreement.h"
+#include "test_meshes.h"
+#include "volume/lpv_stages.h"
+#include "volume/ray_scene.h"
+#include "volume/voxelize.h"
+
+namespace {
+using namespace sslpv;
+using namespace sslpv::test;
+
+/// An object with its LPV lit and propagated on the CPU, ready to shade.
+struct LitObject {
+  TriangleMesh mesh;
+  MaterialGrid material;
+  ShGrid accumulated;
+};
+
+LitObject lightObject(TriangleMesh mesh, const std::vector<Light>& lights, double ior, int resolution) {
+  LitObject o;
+  o.mesh = std::move(mesh);
+  o.material.frame = makeGridFrame(o.mesh.bounds(), resolution);
+  const GridFrame& frame = o.material.frame;
+  o.material.coverage = voxelizeCoverage(o.mesh, frame);
+  // A marble-like medium in scene units of about a tenth of the object's size.
+  o.material.sigmaT.assign(frame.cellCount(), glm::vec3(8.0f, 9.0f, 10.0f));
+  o.material.sigmaS.assign(frame.cellCount(), glm::vec3(7.9f, 8.8f, 9.5f));
+  o.material.g.assign(frame.cellCount(), 0.0f);
+  RayScene rays(o.mesh);
+  std::vector<SurfaceFluxSample> samples;
+  for (const Light& light : lights) {
+    const auto lightSamples = castShadowMap(light, rays, o.mesh.bounds(), 256, ior);
+    samples.insert(samples.end(), lightSamples.begin(), lightSamples.end());
+  }
+  ShGrid field;
+  field.resize(frame);
+  o.accumulated.resize(frame);
+  injectSamples(samples, o.material, field);
+  PropagationOptions options;
+  options.steps = 24;
+  propagate(o.material, computeStepFactors(o.material), field, o.accumulated, options);
+  return o;
+}
+
+Camera cameraAt(glm::dvec3 position, glm::dvec3 target, int width, int height, double fovY = 35.0) {
+  Camera c;
+  c.position = position;
+  c.target = target;
+  c.up = glm::dvec3(0.0, 1.0, 0.0);
+  c.fovYDeg = fovY;
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
+class GpuShadeTest : public GpuTest {
+ protected:
+  /// Shades `o` from `camera` with both backends and checks the expectations above.
+  void compareWithCpu(const LitObject& o, const Camera& camera, double ior, const std::string& what) {
+    RayScene rays(o.mesh);
+    const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, ior);
+    gpu::GpuMesh mesh(device(), o.mesh);
+    gpu::GpuShader shader(device(), mesh, camera.width, camera.height);
+    const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
+    const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
+    const Image gpuImage = shader.shade(camera, field, coverage, o.material.frame, ior);
+    ASSERT_EQ(gpuImage.width, cpu.width);
+    ASSERT_EQ(gpuImage.height, cpu.height);
+    const ImageAgreement a = compareImages(gpuImage, cpu, shader.readTriangles(), cpuTriangles(camera, rays));
+    std::cout << what << ": object pixels " << a.objectPixels << " (" << a.silhouette << " silhouette, " << a.edge
+              << " edge), mean relative " << a.meanRelative << ", worst interior " << a.worstInterior << " at ("
+              << a.worstX << ", " << a.worstY << "), background mismatches " << a.backgroundMismatches
+              << ", surface mismatches " << a.surfaceMismatches << ", GPU " << shader.lastShadeMs() << " ms\n";
+    EXPECT_GT(a.interior, std::size_t(camera.width) * camera.height / 10)
+        << what << ": the object should fill the view";
+    EXPECT_EQ(a.backgroundMismatches, 0u) << what;
+    EXPECT_EQ(a.surfaceMismatches, 0u) << what;
+    EXPECT_LE(double(a.edge), 0.01 * double(a.objectPixels)) << what;
+    EXPECT_LE(a.worstInterior, 0.02) << what;
+    EXPECT_LE(a.meanRelative, 0.01) << what;
+  }
+};
+
+Light pointLight(glm::dvec3 position, glm::vec3 intensity) {
+  Light l;
+  l.type = Light::Type::Point;
+  l.position = position;
+  l.intensity = intensity;
+  return l;
+}
+
+Light directionalLight(glm::dvec3 direction, glm::vec3 irradiance) {
+  Light l;
+  l.type = Light::Type::Directional;
+  l.direction = glm::normalize(direction);
+  l.irradiance = irradiance;
+  return l;
+}
+
+TEST_F(GpuShadeTest, SphereMatchesCpuShading) {
+  const std::vector<Light> lights = {pointLight({1.5, 2.0, 3.0}, {10.0f, 8.0f, 6.0f}),
+                                     directionalLight({0.5, 0.2, 1.0}, {1.0f, 1.5f, 2.0f})};
+  const LitObject o = lightObject(makeIcosphere(glm::vec3(0.1f, -0.2f, 0.3f), 1.0f, 5), lights, 1.3, 32);
+  compareWithCpu(o, cameraAt({0.8, 0.9, 4.5}, {0.1, -0.2, 0.3}, 512, 512), 1.3, "sphere 512x512");
+  // Non-square, and the camera off to the side: checks the aspect and the row order.
+  compareWithCpu(o, cameraAt({-3.5, 0.4, 2.0}, {0.3, -0.3, 0.2}, 320, 200, 40.0), 1.3, "sphere 320x200");
+  // Inside the bounding box but outside the sphere: back faces are not culled there.
+  compareWithCpu(o, cameraAt({0.85, 0.6, 1.1}, {0.1, -0.2, 0.3}, 256, 256, 100.0), 1.3, "sphere from a box corner");
+}
+
+TEST_F(GpuShadeTest, FromInsideTheObjectEverythingIsBlackOnBoth) {
+  // The CPU sees the surface from inside (cos θo <= 0) and leaves every pixel black; the
+  // GPU must see the same nearest (back-facing) surface, not cull it and show what lies
+  // behind it.
+  const LitObject o =
+      lightObject(makeIcosphere(glm::vec3(0.0f), 1.0f, 4), {pointLight({0, 2, 3}, glm::vec3(5.0f))}, 1.3, 24);
+  const Camera camera = cameraAt({0.1, 0.2, 0.3}, {1.0, 0.0, 0.0}, 128, 96, 60.0);
+  RayScene rays(o.mesh);
+  const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, 1.3);
+  gpu::GpuMesh mesh(device(), o.mesh);
+  gpu::GpuShader shader(device(), mesh, camera.width, camera.height);
+  const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
+  const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
+  const Image gpuImage = shader.shade(camera, field, coverage, o.material.frame, 1.3);
+  const std::vector<std::uint32_t> gpuTriangles = shader.readTriangles(), cpuTri = cpuTriangles(camera, rays);
+  std::size_t black = 0, sameTriangle = 0;
+  for (std::size_t i = 0; i < cpu.pixels.size(); ++i) {
+    black += cpu.pixels[i] == glm::vec3(0.0f) && gpuImage.pixels[i] == glm::vec3(0.0f);
+    sameTriangle += gpuTriangles[i] != 0 && gpuTriangles[i] == cpuTri[i];
+  }
+  EXPECT_EQ(black, cpu.pixels.size());
+  EXPECT_GE(double(sameTriangle), 0.99 * double(cpu.pixels.size()));
+}
+
+TEST_F(GpuShadeTest, BoxMatchesCpuShadingIndexMatched) {
+  const std::vector<Light> lights = {pointLight({0.5, 2.5, 2.0}, {6.0f, 6.0f, 6.0f}),
+                                     directionalLight({-0.3, -0.2, -1.0}, {1.0f, 1.0f, 1.0f})};
+  const LitObject o =
+      lightObject(makeBoxMesh(glm::vec3(-1.0f, -0.7f, -0.5f), glm::vec3(1.2f, 1.0f, 0.5f)), lights, 1.0, 24);
+  compareWithCpu(o, cameraAt({2.2, 1.8, 3.4}, {0.1, 0.15, 0.0}, 384, 384), 1.0, "box 384x384");
+}
+
+TEST_F(GpuShadeTest, ReportsGpuTimeOfA512ImageOfA20KTriangleSphere) {
+  // Not a performance assertion: prints the GPU time (timestamps) of shading a 512²
+  // image of a 20,480-triangle sphere filling about half of it, median of 5 runs after
+  // a warm-up.
+  const LitObject o =
+      lightObject(makeIcosphere(glm::vec3(0.0f), 1.0f, 5), {pointLight({0, 2, 3}, glm::vec3(5.0f))}, 1.3, 32);
+  const Camera camera = cameraAt({0.0, 0.5, 4.0}, {0.0, 0.0, 0.0}, 512, 512);
+  gpu::GpuMesh mesh(device(), o.mesh);
+  gpu::GpuShader shader(device(), mesh, 512, 512);
+  const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
+  const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
+  shader.shade(camera, field, coverage, o.material.frame, 1.3);
+  std::vector<double> ms;
+  for (int i = 0; i < 5; ++i) {
+    shader.shade(camera, field, coverage, o.material.frame, 1.3);
+    ms.push_back(shader.lastShadeMs());
+  }
+  std::sort(ms.begin(), ms.end());
+  std::cout << "GPU shading 512^2, " << o.mesh.triangles.size() << " triangles, " << device().name() << ": median "
+            << ms[2] << " ms (min " << ms[0] << ", max " << ms[4] << ")\n";
+  RecordProperty("gpu_shade_ms", std::to_string(ms[2]));
+  if (device().timestampValidBits() > 0) {
+    EXPECT_GT(ms[2], 0.0);
+  }
+}
+
+}  // namespace
