@@ -255,6 +255,10 @@ TriangleMesh loadMesh(const MeshSource& source, const Transform& transform) {
     case MeshSource::Kind::Box: mesh = makeBox(source); break;
     case MeshSource::Kind::Sphere: mesh = makeSphere(source); break;
     case MeshSource::Kind::File: mesh = loadMeshFile(source.path); break;
+    case MeshSource::Kind::InMemory:
+      if (!source.mesh) throw InputError("mesh: in-memory mesh missing");
+      mesh = *source.mesh;
+      break;
   }
   if (!(transform.scale > 0.0) || !std::isfinite(transform.scale))
     throw InputError(mesh.name + ": transform scale must be positive, got " + std::to_string(transform.scale));

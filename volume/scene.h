@@ -3,6 +3,7 @@
 // missing required keys and out-of-range values are InputErrors naming the key path,
 // e.g. "scene.json: lights[1].intensity: expected an array of 3 non-negative numbers".
 #include <filesystem>
+#include <memory>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 #include <optional>
@@ -13,10 +14,15 @@
 
 namespace sslpv {
 
+struct TriangleMesh;
+
 struct MeshSource {
-  enum class Kind { File, Box, Sphere };
+  /// InMemory: a mesh made by a program (a generated benchmark mesh, an editor's
+  /// deformed copy), never from a scene file.
+  enum class Kind { File, Box, Sphere, InMemory };
   Kind kind = Kind::Box;
   std::filesystem::path path;  ///< Kind::File: resolved against the scene file's folder
+  std::shared_ptr<const TriangleMesh> mesh;  ///< Kind::InMemory: in the object's rest space
   glm::dvec3 boxMin{-0.5}, boxMax{0.5};
   glm::dvec3 center{0.0};
   double radius = 0.5;
