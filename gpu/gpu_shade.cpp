@@ -14,7 +14,7 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 6;  // see the bindings of shaders/shade.{vert,comp}
+constexpr std::uint32_t kBindings = 7;  // see the bindings of shaders/shade.{vert,comp}
 constexpr VkFormat kTriangleFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
@@ -115,6 +115,7 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
   sets_.write(0, 1, mesh_.indices());
   sets_.write(0, 2, accumulated);
   sets_.write(0, 3, cellCoverage);
+  sets_.write(0, 6, mesh_.vertexFans());
   const GpuShadePush push = shadePush(camera, mesh_.bounds(), frame, ior);
 
   if (timestamps) timestamps->write(cmd, firstQuery);
@@ -143,8 +144,9 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
                VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
   copyImageToBuffer(cmd, triangleImage_, triangleIds_);
+  // The resolve reads the copied ids and writes back the triangle each ray crosses.
   pipelineMemoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   shadePipeline_.bind(cmd, sets_.set(0), &push, sizeof push);
   vkCmdDispatch(cmd, (std::uint32_t(width_) + SSLPV_SHADE_GROUP_X - 1) / SSLPV_SHADE_GROUP_X,
                 (std::uint32_t(height_) + SSLPV_SHADE_GROUP_Y - 1) / SSLPV_SHADE_GROUP_Y, 1);

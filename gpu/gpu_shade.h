@@ -2,7 +2,8 @@
 // Shading on the GPU by rasterization: the twin of sslpv::shadeImage (volume/shade.cpp).
 // The mesh is rasterized from the camera (pixel centres are the CPU's camera rays) into a
 // triangle-id image with a depth test; a compute pass then shades every pixel once: its
-// camera ray meets its triangle's plane, the accumulated LPV is read half a cell inside
+// camera ray meets the triangle it crosses (the rasterized one, or the neighbour the
+// exact ray crosses where vertex snapping picked the wrong side of an edge), the accumulated LPV is read half a cell inside
 // the surface (a full cell when no active cell is near) with the coverage-weighted
 // active trilinear weights (shaders/cell_coverage.glsl), and radiance
 // T(θo)/η² · (1/(Aπ)) ∫_H I(ω) dω goes into an RGBA32F buffer (alpha 1 where the surface
@@ -59,7 +60,9 @@ class GpuShader {
   /// puts it into an R32G32B32A32_SFLOAT image for display.
   const Buffer& radiance() const { return radiance_; }
   /// Per pixel, the 1-based index of the triangle seen there (0: background), from the
-  /// last executed recording: which surface each pixel shows (picking, tests).
+  /// last executed recording: the one the pixel's exact ray crosses (the rasterized
+  /// triangle or, within the rasterizer's snapping of an edge, its neighbour), i.e. the
+  /// triangle that was shaded (picking, tests).
   std::vector<std::uint32_t> readTriangles() const;
   int width() const { return width_; }
   int height() const { return height_; }

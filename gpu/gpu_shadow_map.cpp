@@ -8,7 +8,7 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 5;  // see the bindings of shaders/shadow_map.{vert,comp}
+constexpr std::uint32_t kBindings = 6;  // see the bindings of shaders/shadow_map.{vert,comp}
 constexpr VkFormat kTriangleFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkBufferUsageFlags kStorage =
@@ -116,6 +116,7 @@ void GpuShadowMapper::setLights(const std::vector<Light>& lights, double ior) {
   }
   sets_.write(0, 0, mesh_.positions());
   sets_.write(0, 1, mesh_.indices());
+  sets_.write(0, 5, mesh_.vertexFans());
   uploadToBuffer(device_, viewRecords_, records.data(), records.size() * sizeof(GpuShadowView));
 
   lightList_ = lights;
@@ -162,8 +163,9 @@ void GpuShadowMapper::record(VkCommandBuffer cmd, TimestampQueries* timestamps, 
     copyImageToBuffer(cmd, triangleImage_, triangleIds_, v * texelsPerView * sizeof(std::uint32_t));
   }
   if (!views_.empty()) {
+    // The resolve reads the copied ids and writes back the triangle each ray crosses.
     pipelineMemoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     resolvePipeline_.bind(cmd, set);
     const std::uint32_t groups = (std::uint32_t(size_) + SSLPV_SHADOW_RESOLVE_GROUP - 1) / SSLPV_SHADOW_RESOLVE_GROUP;
     vkCmdDispatch(cmd, groups, groups, std::uint32_t(views_.size()));

@@ -4,7 +4,8 @@
 // (volume/shadow_view.h), so both cast the same texel rays. Per view, the mesh is
 // rasterized into a triangle-id image (pixel centres = texel rays, nearest surface by a
 // depth test); a compute resolve then intersects each texel's exact ray with its
-// triangle and writes one GpuFluxSample per texel (shaders/flux_sample_shared.h) into one
+// triangle (or, where vertex snapping put the texel on the wrong side of an edge, with
+// the neighbour the ray crosses: shaders/ray_triangle_pick.glsl) and writes one GpuFluxSample per texel (shaders/flux_sample_shared.h) into one
 // device buffer, all views of all lights concatenated, misses included (w = 0).
 #include <vulkan/vulkan.h>
 

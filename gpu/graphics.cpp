@@ -1,6 +1,7 @@
 #include "gpu/graphics.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <string>
 
@@ -348,8 +349,9 @@ GpuMesh::GpuMesh(const VulkanDevice& device, const TriangleMesh& mesh) {
   const VkDeviceSize positionBytes = VkDeviceSize(std::max<std::size_t>(vertices, 1)) * 4 * sizeof(float);
   const VkDeviceSize indexBytes = VkDeviceSize(std::max<std::size_t>(triangles, 1)) * 3 * sizeof(std::uint32_t);
   const VkDeviceSize range = device.properties().limits.maxStorageBufferRange;
+  const VkDeviceSize fanBytes = (VkDeviceSize(vertices) + 1 + 3 * VkDeviceSize(triangles)) * sizeof(std::uint32_t);
   // Non-indexed draws of 3 vertices a triangle: gl_VertexIndex must stay in range too.
-  if (positionBytes > range || indexBytes > range || triangles > std::size_t(0x7fffffff) / 3)
+  if (positionBytes > range || indexBytes > range || fanBytes > range || triangles > std::size_t(0x7fffffff) / 3)
     throw GpuError("GpuMesh: mesh '" + mesh.name + "' (" + std::to_string(vertices) + " vertices, " +
                    std::to_string(triangles) + " triangles) exceeds the Vulkan device's storage-buffer range of " +
                    std::to_string(range >> 20) + " MiB");
@@ -367,6 +369,17 @@ GpuMesh::GpuMesh(const VulkanDevice& device, const TriangleMesh& mesh) {
   vertexCount_ = std::uint32_t(vertices);
   triangleCount_ = std::uint32_t(triangles);
   uploadToBuffer(device, indices_, indices.data(), indices.size() * sizeof(std::uint32_t));
+  // Vertex fans by counting sort: offsets first (shifted past the offset table itself, so
+  // one array serves the shaders), then each triangle appended to its three vertices' lists.
+  std::vector<std::uint32_t> fans(vertices + 1 + 3 * triangles, 0u);
+  for (const std::uint32_t v : indices) ++fans[v + 1];
+  fans[0] = std::uint32_t(vertices + 1);
+  for (std::size_t v = 0; v < vertices; ++v) fans[v + 1] += fans[v];
+  std::vector<std::uint32_t> next(fans.begin(), fans.begin() + std::ptrdiff_t(vertices));
+  for (std::size_t t = 0; t < triangles; ++t)
+    for (int c = 0; c < 3; ++c) fans[next[indices[3 * t + c]]++] = std::uint32_t(t);
+  vertexFans_ = Buffer(device, fanBytes, storage, MemoryUse::Device);
+  uploadToBuffer(device, vertexFans_, fans.data(), fans.size() * sizeof(std::uint32_t));
   updatePositions(device, mesh.positions);
 }
 

@@ -1,6 +1,7 @@
 #version 460
 // GPU twin of the per-pixel work of sslpv::shadeImage (volume/shade.cpp), on the
-// triangle the rasterizer found nearest at each pixel centre (shaders/shade.vert/.frag):
+// triangle the rasterizer found nearest at each pixel centre (shaders/shade.vert/.frag),
+// or the neighbour the exact ray crosses (shaders/ray_triangle_pick.glsl):
 // the pixel's camera ray meets the triangle's plane; the accumulated LPV is read half a
 // cell inside the surface (a full cell when no active cell is near) with the
 // coverage-weighted active trilinear weights of activeTrilinearWeights; radiance
@@ -21,9 +22,14 @@ layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[
 layout(std430, set = 0, binding = 1) readonly buffer Indices { uint indices[]; };
 // The accumulated light field: 3 vec4 per cell, (c0, c1x, c1y, c1z) per channel.
 layout(std430, set = 0, binding = 2) readonly buffer Field { vec4 field[]; };
-layout(std430, set = 0, binding = 4) readonly buffer Triangles { uint triangles[]; };  // per pixel, 1-based, 0 = none
+// Per pixel, 1-based, 0 = none: the rasterized triangle in, the one the pixel's ray
+// crosses out (GpuShader::readTriangles).
+layout(std430, set = 0, binding = 4) buffer Triangles { uint triangles[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Radiance { vec4 radiance[]; };
+layout(std430, set = 0, binding = 6) readonly buffer VertexFans { uint vertexFans[]; };
 layout(push_constant) uniform Push { GpuShadePush push; };
+
+#include "shaders/ray_triangle_pick.glsl"
 
 void main() {
   const uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -39,7 +45,15 @@ void main() {
   const float u = (2.0 * (float(pixel.x) + 0.5) / push.viewport.x - 1.0) * push.forward.w;
   const float v = (1.0 - 2.0 * (float(pixel.y) + 0.5) / push.viewport.y) * push.right.w;
   const vec3 dir = normalize(push.forward.xyz + u * push.right.xyz + v * push.up.xyz);
-  const uint first = 3u * (id - 1u);
+  // Within the rasterizer's snapping of an edge, the neighbour the exact ray crosses.
+  const uint triangle = pickCrossedTriangle(push.eye.xyz, dir, id - 1u);
+  if (triangle == SSLPV_NO_TRIANGLE) {
+    triangles[index] = 0u;
+    radiance[index] = vec4(0.0);
+    return;
+  }
+  triangles[index] = triangle + 1u;
+  const uint first = 3u * triangle;
   const vec3 v0 = positions[indices[first]].xyz;
   const vec3 v1 = positions[indices[first + 1u]].xyz;
   const vec3 v2 = positions[indices[first + 2u]].xyz;

@@ -1,8 +1,9 @@
 #version 460
 // Shadow-map resolve, the GPU twin of the per-hit work of sslpv::castShadowMap
 // (volume/shadow_map.cpp): per texel of every view, the texel ray (ShadowView::texelRay),
-// its hit on the triangle the rasterizer found there, the outward geometric normal, the
-// light arriving (I dω or E dA, nothing outside a spot's cone), Fresnel transmittance and
+// its hit on the triangle it crosses (the rasterized one or, within the rasterizer's
+// snapping of an edge, a neighbour: shaders/ray_triangle_pick.glsl), the outward
+// geometric normal, the light arriving (I dω or E dA, nothing outside a spot's cone), Fresnel transmittance and
 // the refracted direction, written as one GpuFluxSample (misses: all zero).
 #extension GL_GOOGLE_include_directive : require
 #include "shaders/flux_sample_shared.h"
@@ -14,8 +15,12 @@ layout(local_size_x = SSLPV_SHADOW_RESOLVE_GROUP, local_size_y = SSLPV_SHADOW_RE
 layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Indices { uint indices[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Views { GpuShadowView views[]; };
-layout(std430, set = 0, binding = 3) readonly buffer Triangles { uint triangles[]; };  // 1-based, 0 = none
+// 1-based, 0 = none: the rasterized triangle in, the one the texel's ray crosses out.
+layout(std430, set = 0, binding = 3) buffer Triangles { uint triangles[]; };
 layout(std430, set = 0, binding = 4) writeonly buffer Samples { GpuFluxSample samples[]; };
+layout(std430, set = 0, binding = 5) readonly buffer VertexFans { uint vertexFans[]; };
+
+#include "shaders/ray_triangle_pick.glsl"
 
 void main() {
   const GpuShadowView view = views[gl_WorkGroupID.z];
@@ -50,7 +55,11 @@ void main() {
       dir = view.forward.xyz;
       weight = side * side;
     }
-    const uint triangle = id - 1u;
+    uint triangle = pickCrossedTriangle(origin, dir, id - 1u);
+    triangles[index] = triangle == SSLPV_NO_TRIANGLE ? 0u : triangle + 1u;
+    // A ray just outside the silhouette: read triangle 0's vertices harmlessly, inject nothing.
+    const bool crossed = triangle != SSLPV_NO_TRIANGLE;
+    if (!crossed) triangle = 0u;
     const vec3 v0 = positions[indices[3u * triangle]].xyz;
     const vec3 v1 = positions[indices[3u * triangle + 1u]].xyz;
     const vec3 v2 = positions[indices[3u * triangle + 2u]].xyz;
@@ -61,7 +70,7 @@ void main() {
     const float cosI = -dot(dir, n);
     // Grazing or from inside: no light enters here (also rejects degenerate triangles).
     const vec3 power = dot(dir, view.coneAxis.xyz) < view.power.w ? vec3(0.0) : view.power.rgb * weight;
-    if (cosI > 0.0 && power != vec3(0.0)) {
+    if (crossed && cosI > 0.0 && power != vec3(0.0)) {
       const float t = dot(v0 - origin, ng) / dot(dir, ng);
       const float eta = view.coneAxis.w;
       const float transmittance = 1.0 - fresnelReflectance(cosI, eta);

@@ -16,12 +16,18 @@
 // - Where both hit, both intersect the same triangle's plane in float. The hit distance
 //   along a ray is ill-conditioned by 1/cos θi at grazing incidence, so positions must
 //   agree within |Δp| cos θi <= 1e-5 of the object's radius.
-// - The triangle may differ where the texel centre lies within the rasterizer's vertex
-//   snapping (llvmpipe: 1/256 texel) of an edge shared by two triangles, whose face
-//   normals differ by a few degrees on these meshes. Normals differing by more than 1e-4
-//   count as such texels: at most 1 % of the common hits (the expected share is the
-//   snapping band times the edge length per texel, well below that for triangles of 1.5
-//   texels or more); they are excluded from the direction and flux checks.
+// - The triangle: the rasterizer snaps vertices (llvmpipe: 1/256 texel), so where a texel
+//   centre lies that close to an edge it may report the neighbour; the resolve then
+//   tests the exact ray against the neighbours and takes the one it crosses, as Embree
+//   does. A texel whose GPU normal differs from the CPU's by more than 1e-4 (face normals
+//   differ by degrees on these meshes) is an "other triangle" texel. Those are allowed
+//   only where the CPU hit lies within float rounding of an edge of its triangle (2e-6
+//   of the radius: coordinates of a few radii carry ~1e-7 relative rounding on both
+//   sides, while the snapping band is 3e-5 radius at 256²): there the two ray casters
+//   may legitimately split differently. Elsewhere at most 1 in 10,000 (before the
+//   neighbour test 16 to 27 other-triangle texels per light on the sphere; now 1 to 4,
+//   of which 0 or 1 off the band, where Embree's own float test is not watertight),
+//   and in all at most 0.1 % of the common hits. They are excluded from the direction and flux checks.
 // - Elsewhere normals and refracted directions agree within 1e-5, and flux (float texel
 //   solid angle and Fresnel against double) within 1e-5 of |flux| + the largest texel
 //   flux. With η < 1, texels within 0.2° of the critical angle are excluded from the
@@ -124,16 +130,30 @@ std::vector<std::optional<SurfaceFluxSample>> cpuTexels(const std::vector<Surfac
 
 struct Agreement {
   std::size_t cpuHits = 0, gpuHits = 0, silhouette = 0, silhouetteMismatches = 0, otherMismatches = 0;
-  std::size_t common = 0, otherTriangle = 0, nearCritical = 0;
+  std::size_t common = 0, otherTriangle = 0, otherTriangleOffEdge = 0, nearCritical = 0;
   double worstPosition = 0;  ///< |Δp| cos θi / radius
   double worstNormal = 0, worstDirection = 0, worstFlux = 0;
   double worstCriticalDirection = 0, worstCriticalFlux = 0;  ///< within kCriticalBand, flux / max flux
   glm::dvec3 cpuFlux{0.0}, gpuFlux{0.0};
 };
 
-/// Compares one light's texels (`gpu` from its first sample on, `cpu` per texel).
+/// Distance from `p` (on the plane of `triangle`) to the nearest of its edges.
+double distanceToEdges(const TriangleMesh& mesh, unsigned triangle, const glm::dvec3& p) {
+  double nearest = 1e300;
+  for (int e = 0; e < 3; ++e) {
+    const glm::dvec3 a(mesh.positions[mesh.triangles[triangle][e]]);
+    const glm::dvec3 b(mesh.positions[mesh.triangles[triangle][(e + 1) % 3]]);
+    const double s = std::clamp(glm::dot(p - a, b - a) / glm::dot(b - a, b - a), 0.0, 1.0);
+    nearest = std::min(nearest, glm::length(p - (a + s * (b - a))));
+  }
+  return nearest;
+}
+
+/// Compares one light's texels (`gpu` from its first sample on, `cpu` per texel). `rays`
+/// and `mesh` find the CPU's triangle of the texels where the two disagree.
 Agreement compareTexels(const GpuFluxSample* gpu, const std::vector<std::optional<SurfaceFluxSample>>& cpu,
-                        const std::vector<ShadowView>& views, double radius, double ior) {
+                        const std::vector<ShadowView>& views, double radius, double ior, const RayScene& rays,
+                        const TriangleMesh& mesh) {
   const std::size_t viewCount = views.size();
   Agreement a;
   double maxFlux = 0.0;
@@ -170,6 +190,10 @@ Agreement compareTexels(const GpuFluxSample* gpu, const std::vector<std::optiona
         const double normal = glm::length(glm::vec3(g.normal) - c.normal);
         if (normal > 1e-4) {
           ++a.otherTriangle;
+          const TexelRay ray = views[v].texelRay(x, y);
+          const RayHit hit = rays.intersect(glm::vec3(ray.origin), glm::vec3(ray.dir));
+          if (!hit.hit || distanceToEdges(mesh, hit.triangle, glm::dvec3(hit.position)) > 2e-6 * radius)
+            ++a.otherTriangleOffEdge;
           continue;
         }
         if (ior < 1.0 && std::abs(std::acos(std::min(1.0, cosI)) - std::asin(ior)) < kCriticalBand) {
@@ -192,7 +216,8 @@ Agreement compareTexels(const GpuFluxSample* gpu, const std::vector<std::optiona
 void expectAgreement(const Agreement& a, const std::string& what) {
   std::cout << what << ": cpu hits " << a.cpuHits << ", gpu hits " << a.gpuHits << ", silhouette texels "
             << a.silhouette << " (" << a.silhouetteMismatches << " disagree), other disagreements " << a.otherMismatches
-            << ", other triangle " << a.otherTriangle << " of " << a.common << ", near the critical angle "
+            << ", other triangle " << a.otherTriangle << " of " << a.common << " (" << a.otherTriangleOffEdge
+            << " off the edges), near the critical angle "
             << a.nearCritical << " (worst direction " << a.worstCriticalDirection << ", flux " << a.worstCriticalFlux
             << ")"
             << ", worst position " << a.worstPosition << " radius, normal " << a.worstNormal << ", direction "
@@ -201,7 +226,8 @@ void expectAgreement(const Agreement& a, const std::string& what) {
   EXPECT_GT(a.cpuHits, 1000u) << what << ": the case should light a good part of the map";
   EXPECT_EQ(a.otherMismatches, 0u) << what;
   EXPECT_LE(double(a.silhouetteMismatches), 0.02 * double(a.silhouette)) << what;
-  EXPECT_LE(double(a.otherTriangle), 0.01 * double(a.common)) << what;
+  EXPECT_LE(double(a.otherTriangleOffEdge), std::max(1.0, 1e-4 * double(a.common))) << what;
+  EXPECT_LE(double(a.otherTriangle), 0.001 * double(a.common)) << what;
   EXPECT_LE(a.worstPosition, 1e-5) << what;
   EXPECT_LE(a.worstNormal, 1e-5) << what;
   EXPECT_LE(a.worstDirection, 1e-5) << what;
@@ -243,7 +269,8 @@ class GpuShadowMapTest : public GpuTest {
       EXPECT_EQ(placed.sampleCount, cpuStats.texels) << what;
       if (cpuStats.culled) continue;
       const Agreement a =
-          compareTexels(samples.data() + placed.firstSample, cpuTexels(cpuSamples, views), views, radius, c.ior);
+          compareTexels(samples.data() + placed.firstSample, cpuTexels(cpuSamples, views), views, radius, c.ior,
+                        rays, c.mesh);
       expectAgreement(a, what);
       EXPECT_EQ(gpuStats[l].hits, a.gpuHits) << what;
       for (int ch = 0; ch < 3; ++ch) {

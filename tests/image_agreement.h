@@ -21,9 +21,9 @@ namespace sslpv::test {
 
 inline bool isBackground(const Image& image, int x, int y) { return image.at(x, y) == glm::vec3(0.0f); }
 
-/// Per pixel, the 1-based triangle the camera ray of shadeImage (volume/shade.cpp, whose
-/// ray set-up this repeats) hits first, 0 for none.
-inline std::vector<std::uint32_t> cpuTriangles(const Camera& camera, const RayScene& rays) {
+/// Per pixel, the first hit of the camera ray of shadeImage (volume/shade.cpp, whose ray
+/// set-up this repeats).
+inline std::vector<RayHit> cpuHits(const Camera& camera, const RayScene& rays) {
   const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
   const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
   const glm::dvec3 up = glm::cross(right, forward);
@@ -39,8 +39,14 @@ inline std::vector<std::uint32_t> cpuTriangles(const Camera& camera, const RaySc
     }
   std::vector<RayHit> hits(pixels);
   rays.intersectMany(origins.data(), dirs.data(), hits.data(), pixels);
-  std::vector<std::uint32_t> triangles(pixels);
-  for (std::size_t i = 0; i < pixels; ++i) triangles[i] = hits[i].hit ? hits[i].triangle + 1 : 0;
+  return hits;
+}
+
+/// Per pixel, the 1-based triangle the camera ray of shadeImage hits first, 0 for none.
+inline std::vector<std::uint32_t> cpuTriangles(const Camera& camera, const RayScene& rays) {
+  const std::vector<RayHit> hits = cpuHits(camera, rays);
+  std::vector<std::uint32_t> triangles(hits.size());
+  for (std::size_t i = 0; i < hits.size(); ++i) triangles[i] = hits[i].hit ? hits[i].triangle + 1 : 0;
   return triangles;
 }
 
