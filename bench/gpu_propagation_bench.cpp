@@ -1,55 +1,71 @@
-// LPV propagation time per step, Vulkan backend against the CPU backend, on cubic grids
-// whose interior cells are all active. Prints a table; not a test (no timing asserts).
+// LPV propagation per step, Vulkan backend (device-resident: GpuPropagator::runOnDevice)
+// against the CPU backend (sslpv::propagate), on cubic grids filled as a full cube, a
+// sphere or a thin spherical shell. Prints a table; a program, not a test (no asserts).
 //
-//   gpu_propagation_bench [--sizes 32,64] [--steps 8] [--repeats 3] [--group XxY] [--zchunk N]
+//   gpu_propagation_bench [--sizes 16,32,64,128] [--steps 4,8,16,32,auto]
+//                         [--shapes cube,sphere,shell] [--repeats 5] [--rows N] [--zchunk N]
+//                         [--no-cpu]
+//
+// Every time is the MEDIAN of --repeats runs after one warm-up run (shader JIT, caches).
+// GPU ms/step: propagation kernel + per-step reduction from GPU timestamps, divided by
+// the steps that ran; "wall" adds submission and synchronization (runOnDevice as a whole,
+// no host upload or readback). CPU ms/step: wall time of propagate(). Mcells/s counts
+// ACTIVE cells x steps per second, so a sphere and a cube compare on useful work.
+//
+// Roofline. The same run measures the device's own peaks, again just before every row: FMA rate (lpv_peak_fma.comp)
+// and copy bandwidth (the vec4 STREAM triad of lpv_peak_triad.comp, read as storage
+// buffers and as texel buffers; the better of the two is the roof). Work per active cell
+// and step, counted by hand from the kernel as written (shaders/lpv_transfer.glsl and
+// lpv_propagate.comp), 1 flop per add, sub, mul, max or div, halo cells that are
+// normalized a second time not counted (useful work only):
+//   normalize the cell and form its 6 lobes: 3 channels x (169 for the 30 clamped faces
+//     and their lobes + 7 for the scale and power sums + 24 scaling the lobes)  = 600
+//   gather: 6 lobes of 4 floats added per channel                              =  72
+//   step factors + power sums                                                  =  42
+//   accumulate (2 adds x 12 floats, every other step)                           =  12
+//   total                                                                        726 flop
+// (the CPU's structure, normalize then evaluate the faces again per neighbour, needs
+// 1024). Bytes per active cell and step, compulsory memory traffic (halos assumed
+// cached): source 48 + factors 32 + destination 48 + accumulated (48 read + 48 written
+// every other step) 48 = 176 B, so 4.1 flop/B. Attainable = min(peak FMA, 4.1 x
+// bandwidth); "roof %" is the kernel's achieved GFLOP/s over that.
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "gpu/compute.h"
 #include "gpu/gpu_propagation.h"
+#include "shaders/spirv_library.h"
 #include "volume/lpv_constants.h"
 #include "volume/lpv_stages.h"
 
 namespace {
 using namespace sslpv;
 
-MaterialGrid uniformMaterial(int n) {
-  MaterialGrid m;
-  m.frame.dims = glm::ivec3(n);
-  const std::size_t cells = m.frame.cellCount();
-  m.coverage.assign(cells, 1.0f);
-  m.sigmaT.assign(cells, glm::vec3(1.0f, 1.2f, 1.5f));
-  m.sigmaS.assign(cells, glm::vec3(0.95f, 1.0f, 1.1f));
-  m.g.assign(cells, 0.2f);
-  return m;
+constexpr double kFlopsPerCellStep = 3 * (169 + 7 + 24) + 3 * 24 + 42 + 12;
+constexpr double kBytesPerCellStep = 48 + 32 + 48 + 48;
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-/// Light everywhere (an isotropic part plus a tilt), so no cell takes a shortcut.
-ShGrid litField(const MaterialGrid& m) {
-  ShGrid field;
-  field.resize(m.frame);
-  for (std::size_t i = 0; i < m.frame.cellCount(); ++i)
-    for (int ch = 0; ch < 3; ++ch) {
-      field.plane(ch, 0)[i] = 1.0f + 0.01f * float(i % 7);
-      field.plane(ch, 1)[i] = 0.3f;
-      field.plane(ch, 3)[i] = -0.2f;
-    }
-  return field;
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-double seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-/// Processor time of the whole process (all threads, lavapipe's workers included): less
-/// sensitive than wall time to other work on a shared machine.
+/// Processor time of the whole process (lavapipe's worker threads included): on a shared
+/// machine it shows how much work a run was, whatever else competes for the cores.
 double processCpuSeconds() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -57,9 +73,186 @@ double processCpuSeconds() {
          1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
+enum class Shape { Cube, Sphere, Shell };
+const char* shapeName(Shape s) { return s == Shape::Cube ? "cube" : s == Shape::Sphere ? "sphere" : "shell"; }
+
+/// A translucent material (albedo near 1, mild forward scattering) on an n^3 grid:
+/// every interior cell (cube), a ball of radius 0.45 n (sphere, ~38 % of the cube), or
+/// its outer 2 cells (shell).
+MaterialGrid makeMaterial(int n, Shape shape) {
+  MaterialGrid m;
+  m.frame.dims = glm::ivec3(n);
+  const std::size_t cells = m.frame.cellCount();
+  m.coverage.assign(cells, 0.0f);
+  m.sigmaT.assign(cells, glm::vec3(1.0f, 1.2f, 1.5f));
+  m.sigmaS.assign(cells, glm::vec3(0.95f, 1.0f, 1.1f));
+  m.g.assign(cells, 0.2f);
+  const double c = 0.5 * n, radius = 0.45 * n;
+  for (int z = 1; z < n - 1; ++z)
+    for (int y = 1; y < n - 1; ++y)
+      for (int x = 1; x < n - 1; ++x) {
+        const double r = std::sqrt((x + 0.5 - c) * (x + 0.5 - c) + (y + 0.5 - c) * (y + 0.5 - c) +
+                                   (z + 0.5 - c) * (z + 0.5 - c));
+        const bool inside = shape == Shape::Cube || (r < radius && (shape == Shape::Sphere || r > radius - 2.0));
+        if (inside) m.coverage[m.frame.index(x, y, z)] = 1.0f;
+      }
+  return m;
+}
+
+/// Light in every active cell (an isotropic part plus a tilt), none elsewhere, as
+/// injection leaves it; no cell takes a shortcut.
+ShGrid litField(const MaterialGrid& m, const StepFactors& factors) {
+  ShGrid field;
+  field.resize(m.frame);
+  for (std::size_t i = 0; i < m.frame.cellCount(); ++i)
+    if (factors.active[i])
+      for (int ch = 0; ch < 3; ++ch) {
+        field.plane(ch, 0)[i] = 1.0f + 0.01f * float(i % 7);
+        field.plane(ch, 1)[i] = 0.3f;
+        field.plane(ch, 3)[i] = -0.2f;
+      }
+  return field;
+}
+
+struct Peaks {
+  double fmaGflops = 0.0, ssboGBs = 0.0, texelGBs = 0.0;
+  double bandwidth() const { return std::max(ssboGBs, texelGBs); }
+};
+
+/// Median GPU milliseconds of `record` over `repeats` submissions after a warm-up.
+template <typename Record>
+double timeDispatch(gpu::CommandContext& commands, gpu::TimestampQueries& stamps, int repeats, Record record) {
+  std::vector<double> ms;
+  for (int r = 0; r <= repeats; ++r) {
+    VkCommandBuffer cmd = commands.begin();
+    stamps.reset(cmd);
+    stamps.write(cmd, 0);
+    record(cmd);
+    stamps.write(cmd, 1);
+    commands.submitAndWait();
+    if (r > 0) ms.push_back(stamps.readMilliseconds(2)[1]);
+  }
+  return median(ms);
+}
+
+/// The device's own peaks, measured again next to every case: on a shared machine the
+/// cores' speed changes with the other load, and the roofline must be the one the case
+/// actually ran under.
+class PeakProbe {
+ public:
+  explicit PeakProbe(const gpu::VulkanDevice& device)
+      : commands_(device), stamps_(device, 2), fmaResult_(device, kFmaGroups * 64 * 16, kUsage, gpu::MemoryUse::Device) {
+    using namespace gpu;
+    fmaLayout_ = makeStorageBufferSetLayout(device, 1);
+    fma_ = ComputePipeline(device, spirv::lpv_peak_fma_comp(), fmaLayout_.get(), sizeof(int));
+    fmaSets_ = StorageBufferSets(device, fmaLayout_.get(), 1, 1);
+    fmaSets_.write(0, 0, fmaResult_);
+    for (Buffer& b : triadBuffers_) b = Buffer(device, kTriadBytes, kUsage, MemoryUse::Device);
+    // Storage buffers at bindings 0..2, texel views of b and c at 3 and 4.
+    VkDescriptorSetLayoutBinding bindings[5]{};
+    for (std::uint32_t i = 0; i < 5; ++i)
+      bindings[i] = {i, i < 3 ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1,
+                     VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    VkDescriptorSetLayoutCreateInfo layoutInfo{};
+    layoutInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+    layoutInfo.bindingCount = 5;
+    layoutInfo.pBindings = bindings;
+    VkDescriptorSetLayout rawLayout = VK_NULL_HANDLE;
+    SSLPV_VK_CHECK(vkCreateDescriptorSetLayout(device.handle(), &layoutInfo, nullptr, &rawLayout));
+    triadLayout_ = DescriptorSetLayout(device.handle(), rawLayout);
+    const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3},
+                                           {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2}};
+    VkDescriptorPoolCreateInfo poolInfo{};
+    poolInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+    poolInfo.maxSets = 1;
+    poolInfo.poolSizeCount = 2;
+    poolInfo.pPoolSizes = sizes;
+    VkDescriptorPool rawPool = VK_NULL_HANDLE;
+    SSLPV_VK_CHECK(vkCreateDescriptorPool(device.handle(), &poolInfo, nullptr, &rawPool));
+    pool_ = DescriptorPool(device.handle(), rawPool);
+    VkDescriptorSetAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    allocate.descriptorPool = rawPool;
+    allocate.descriptorSetCount = 1;
+    allocate.pSetLayouts = &rawLayout;
+    SSLPV_VK_CHECK(vkAllocateDescriptorSets(device.handle(), &allocate, &triadSet_));
+    for (int k = 0; k < 2; ++k) {
+      VkBufferViewCreateInfo viewInfo{};
+      viewInfo.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+      viewInfo.buffer = triadBuffers_[1 + k].handle();
+      viewInfo.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+      viewInfo.range = VK_WHOLE_SIZE;
+      VkBufferView view = VK_NULL_HANDLE;
+      SSLPV_VK_CHECK(vkCreateBufferView(device.handle(), &viewInfo, nullptr, &view));
+      views_[k] = BufferView(device.handle(), view);
+    }
+    VkDescriptorBufferInfo infos[3];
+    for (int k = 0; k < 3; ++k) infos[k] = {triadBuffers_[k].handle(), 0, VK_WHOLE_SIZE};
+    const VkBufferView rawViews[2] = {views_[0].get(), views_[1].get()};
+    VkWriteDescriptorSet writes[5]{};
+    for (std::uint32_t i = 0; i < 5; ++i) {
+      writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+      writes[i].dstSet = triadSet_;
+      writes[i].dstBinding = i;
+      writes[i].descriptorCount = 1;
+      writes[i].descriptorType = bindings[i].descriptorType;
+      if (i < 3) writes[i].pBufferInfo = &infos[i];
+      else writes[i].pTexelBufferView = &rawViews[i - 3];
+    }
+    vkUpdateDescriptorSets(device.handle(), 5, writes, 0, nullptr);
+    for (std::uint32_t texel = 0; texel < 2; ++texel)
+      triads_[texel] = ComputePipeline(device, spirv::lpv_peak_triad_comp(), rawLayout, sizeof(TriadPush), {texel});
+  }
+
+  Peaks measure(int repeats) {
+    Peaks peaks;
+    const int iterations = kFmaIterations;
+    const double fmaMs = timeDispatch(commands_, stamps_, repeats, [&](VkCommandBuffer cmd) {
+      fma_.bind(cmd, fmaSets_.set(0), &iterations, sizeof(iterations));
+      vkCmdDispatch(cmd, kFmaGroups, 1, 1);
+    });
+    peaks.fmaGflops = double(kFmaGroups) * 64 * kFmaIterations * 128 / (fmaMs * 1e6);  // 16 vec4 FMA chains a lane
+    const TriadPush push{int(kTriadBytes / 16), 0.5f};
+    for (int texel = 0; texel < 2; ++texel) {
+      const double ms = timeDispatch(commands_, stamps_, repeats, [&](VkCommandBuffer cmd) {
+        triads_[texel].bind(cmd, triadSet_, &push, sizeof(push));
+        vkCmdDispatch(cmd, std::uint32_t(push.count / 64), 1, 1);
+      });
+      (texel ? peaks.texelGBs : peaks.ssboGBs) = 3.0 * double(kTriadBytes) / (ms * 1e6);
+    }
+    return peaks;
+  }
+
+ private:
+  using BufferView = gpu::DeviceObject<VkBufferView, vkDestroyBufferView>;
+  struct TriadPush {
+    int count;
+    float scale;
+  };
+  static constexpr std::uint32_t kFmaGroups = 1024;
+  static constexpr int kFmaIterations = 500;
+  static constexpr VkDeviceSize kTriadBytes = VkDeviceSize(16) << 21;  // 32 MiB a buffer: far beyond the caches
+  static constexpr VkBufferUsageFlags kUsage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+
+  gpu::CommandContext commands_;
+  gpu::TimestampQueries stamps_;
+  gpu::Buffer fmaResult_;
+  gpu::DescriptorSetLayout fmaLayout_, triadLayout_;
+  gpu::ComputePipeline fma_, triads_[2];
+  gpu::StorageBufferSets fmaSets_;
+  gpu::Buffer triadBuffers_[3];
+  gpu::DescriptorPool pool_;
+  VkDescriptorSet triadSet_ = VK_NULL_HANDLE;
+  BufferView views_[2];
+};
+
 struct BenchOptions {
-  std::vector<int> sizes{32, 64};
-  int steps = 8, repeats = 3;
+  std::vector<int> sizes{16, 32, 64, 128};
+  std::vector<int> steps{4, 8, 16, 32, 0};  // 0: auto
+  std::vector<Shape> shapes{Shape::Cube, Shape::Sphere, Shape::Shell};
+  int repeats = 5;
+  bool cpu = true;
   gpu::GpuPropagatorOptions gpu;
 };
 
@@ -76,32 +269,91 @@ int parseInt(const std::string& flag, const std::string& value) {
   return parsed;
 }
 
-/// Flags come in pairs; std::invalid_argument names the one that is wrong.
+std::vector<std::string> splitList(const std::string& value) {
+  std::vector<std::string> items;
+  std::stringstream in(value);
+  for (std::string item; std::getline(in, item, ',');) items.push_back(item);
+  return items;
+}
+
+/// std::invalid_argument names the flag or value that is wrong.
 BenchOptions parseOptions(int argc, char** argv) {
   BenchOptions options;
-  if (argc % 2 == 0) throw std::invalid_argument(std::string("missing value after ") + argv[argc - 1]);
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i], value = argv[i + 1];
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    if (flag == "--no-cpu") {
+      options.cpu = false;
+      continue;
+    }
+    if (i + 1 >= argc) throw std::invalid_argument("missing value after " + flag);
+    const std::string value = argv[++i];
     if (flag == "--sizes") {
       options.sizes.clear();
-      std::stringstream in(value);
-      for (std::string item; std::getline(in, item, ',');) options.sizes.push_back(parseInt(flag, item));
+      for (const std::string& item : splitList(value)) options.sizes.push_back(parseInt(flag, item));
     } else if (flag == "--steps") {
-      options.steps = parseInt(flag, value);
+      options.steps.clear();
+      for (const std::string& item : splitList(value)) options.steps.push_back(item == "auto" ? 0 : parseInt(flag, item));
+    } else if (flag == "--shapes") {
+      options.shapes.clear();
+      for (const std::string& item : splitList(value)) {
+        if (item == "cube") options.shapes.push_back(Shape::Cube);
+        else if (item == "sphere") options.shapes.push_back(Shape::Sphere);
+        else if (item == "shell") options.shapes.push_back(Shape::Shell);
+        else throw std::invalid_argument("unknown shape " + item + " for --shapes (cube, sphere, shell)");
+      }
     } else if (flag == "--repeats") {
       options.repeats = parseInt(flag, value);
+    } else if (flag == "--rows") {
+      options.gpu.tileRows = parseInt(flag, value);
     } else if (flag == "--zchunk") {
       options.gpu.zChunk = parseInt(flag, value);
-    } else if (flag == "--group") {
-      const std::size_t x = value.find('x');
-      if (x == std::string::npos) throw std::invalid_argument("malformed value " + value + " for --group (XxY)");
-      options.gpu.groupX = parseInt(flag, value.substr(0, x));
-      options.gpu.groupY = parseInt(flag, value.substr(x + 1));
     } else {
       throw std::invalid_argument("unknown option " + flag);
     }
   }
+  if (options.repeats < 1) throw std::invalid_argument("--repeats must be at least 1");
   return options;
+}
+
+struct GpuRun {
+  int steps = 0;
+  double kernelMs = 0.0, wallMs = 0.0, cpuMs = 0.0;  // per step, medians
+};
+
+GpuRun benchGpu(gpu::GpuPropagator& propagator, const ShGrid& injected, const PropagationOptions& options,
+                int repeats) {
+  std::vector<double> kernel, wall, cpu;
+  GpuRun run;
+  for (int r = 0; r <= repeats; ++r) {  // run 0 warms up (JIT, first touch of memory)
+    propagator.uploadField(injected, propagator.sourceField(), true);  // stands in for GPU injection
+    const auto start = std::chrono::steady_clock::now();
+    const double cpuStart = processCpuSeconds();
+    const PropagationResult result = propagator.runOnDevice(options);
+    const double seconds = secondsSince(start), cpuSeconds = processCpuSeconds() - cpuStart;
+    run.steps = std::max(result.stepsRun, 1);
+    if (r == 0) continue;
+    const gpu::GpuPropagationTimings& t = propagator.timings();
+    kernel.push_back((t.propagateMs + t.reduceMs) / run.steps);
+    wall.push_back(seconds * 1e3 / run.steps);
+    cpu.push_back(cpuSeconds * 1e3 / run.steps);
+  }
+  run.kernelMs = median(kernel);
+  run.wallMs = median(wall);
+  run.cpuMs = median(cpu);
+  return run;
+}
+
+double benchCpu(const MaterialGrid& material, const StepFactors& factors, const ShGrid& injected,
+                const PropagationOptions& options, int repeats) {
+  std::vector<double> ms;
+  for (int r = 0; r <= repeats; ++r) {
+    ShGrid field = injected, accumulated;
+    accumulated.resize(material.frame);
+    const auto start = std::chrono::steady_clock::now();
+    const PropagationResult result = propagate(material, factors, field, accumulated, options);
+    if (r > 0) ms.push_back(secondsSince(start) * 1e3 / std::max(result.stepsRun, 1));
+  }
+  return median(ms);
 }
 
 }  // namespace
@@ -114,46 +366,47 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "gpu_propagation_bench: %s\n", e.what());
     return 2;
   }
-  const int steps = bench.steps, repeats = bench.repeats;
   try {
     gpu::VulkanDevice device;
-    std::printf("device: %s, %d steps, best of %d\n", device.name().c_str(), steps, repeats);
-    std::printf("%6s %7s %7s %12s %12s %12s %12s %12s %12s\n", "grid", "group", "zchunk", "gpu ms/step", "gpu Mcell/s",
-                "gpu cpu-ms", "cpu ms/step", "cpu cpu-ms", "cpu/gpu");
-    for (int n : bench.sizes) {
-      const MaterialGrid material = uniformMaterial(n);
-      const StepFactors factors = computeStepFactors(material);
-      const ShGrid injected = litField(material);
-      PropagationOptions options;
-      options.steps = steps;
-
-      gpu::GpuPropagator propagator(device, material.frame, factors, bench.gpu);
-      // Per step: GPU timestamps, processor time of the GPU run (upload and readback
-      // included), CPU wall time, processor time of the CPU run.
-      double gpuStep = 1e30, gpuCpuTime = 1e30, cpuStep = 1e30, cpuCpuTime = 1e30;
-      for (int r = 0; r < repeats + 1; ++r) {  // the first run pays for shader JIT
-        ShGrid field = injected, accumulated;
-        accumulated.resize(material.frame);
-        const double cpuStart = processCpuSeconds();
-        propagator.run(field, accumulated, options);
-        if (r == 0) continue;
-        gpuCpuTime = std::min(gpuCpuTime, (processCpuSeconds() - cpuStart) * 1e3 / steps);
-        gpuStep = std::min(gpuStep, propagator.timings().propagateMsPerStep());
+    PeakProbe probe(device);
+    const double intensity = kFlopsPerCellStep / kBytesPerCellStep;
+    const Peaks start = probe.measure(bench.repeats);
+    std::printf("device: %s; times are medians of %d runs after a warm-up\n", device.name().c_str(), bench.repeats);
+    std::printf("peaks at the start: FMA %.1f GFLOP/s; vec4 triad %.2f GB/s (storage buffers), %.2f GB/s (texel reads)\n",
+                start.fmaGflops, start.ssboGBs, start.texelGBs);
+    std::printf("per active cell-step: %.0f flop, %.0f B (%.1f flop/B); roofline = min(FMA peak, %.1f x triad peak),\n"
+                "both peaks measured again just before each row (peak GF, GB/s columns)\n",
+                kFlopsPerCellStep, kBytesPerCellStep, intensity, intensity);
+    std::printf("%5s %6s %5s %8s %8s %5s | %8s %8s %8s %8s %7s %7s | %7s %6s %6s | %8s %8s %7s\n", "grid", "shape",
+                "steps", "active", "covered", "items", "gpu ms", "wall ms", "proc ms", "Mcell/s", "GFLOP/s", "GB/s",
+                "peak GF", "GB/s", "roof%", "cpu ms", "Mcell/s", "cpu/gpu");
+    for (int n : bench.sizes)
+      for (Shape shape : bench.shapes) {
+        const MaterialGrid material = makeMaterial(n, shape);
+        const StepFactors factors = computeStepFactors(material);
+        const ShGrid injected = litField(material, factors);
+        gpu::GpuPropagator propagator(device, material.frame, factors, bench.gpu);
+        const double active = double(propagator.activeCells());
+        for (int steps : bench.steps) {
+          PropagationOptions options;
+          options.steps = steps;
+          options.autoSteps = steps == 0;
+          const Peaks peaks = probe.measure(3);
+          const double roof = std::min(peaks.fmaGflops, intensity * peaks.bandwidth());
+          const GpuRun gpuRun = benchGpu(propagator, injected, options, bench.repeats);
+          const double cellRate = active / (gpuRun.kernelMs * 1e-3);  // active cells per second
+          const double gflops = cellRate * kFlopsPerCellStep * 1e-9;
+          const double cpuMs = bench.cpu ? benchCpu(material, factors, injected, options, bench.repeats) : 0.0;
+          const std::string stepsText = steps > 0 ? std::to_string(steps) : "a" + std::to_string(gpuRun.steps);
+          std::printf(
+              "%4d^3 %6s %5s %8.0f %8zu %5zu | %8.3f %8.3f %8.3f %8.1f %7.2f %7.2f | %7.1f %6.2f %6.1f | %8.3f %8.1f %7.2f\n",
+              n, shapeName(shape), stepsText.c_str(), active, propagator.coveredCells(), propagator.itemCount(),
+              gpuRun.kernelMs, gpuRun.wallMs, gpuRun.cpuMs, cellRate * 1e-6, gflops, cellRate * kBytesPerCellStep * 1e-9,
+              peaks.fmaGflops, peaks.bandwidth(), 100.0 * gflops / roof, cpuMs,
+              cpuMs > 0.0 ? active / (cpuMs * 1e3) : 0.0, cpuMs > 0.0 ? cpuMs / gpuRun.kernelMs : 0.0);
+          std::fflush(stdout);
+        }
       }
-      for (int r = 0; r < repeats; ++r) {
-        ShGrid field = injected, accumulated;
-        accumulated.resize(material.frame);
-        const auto start = std::chrono::steady_clock::now();
-        const double cpuStart = processCpuSeconds();
-        propagate(material, factors, field, accumulated, options);
-        cpuStep = std::min(cpuStep, seconds(start) * 1e3 / steps);
-        cpuCpuTime = std::min(cpuCpuTime, (processCpuSeconds() - cpuStart) * 1e3 / steps);
-      }
-      const std::string group = std::to_string(propagator.groupX()) + "x" + std::to_string(propagator.groupY());
-      std::printf("%5d^3 %7s %7d %12.2f %12.1f %12.2f %12.2f %12.2f %12.2f\n", n, group.c_str(), propagator.zChunk(),
-                  gpuStep, double(material.frame.cellCount()) / gpuStep * 1e-3, gpuCpuTime, cpuStep, cpuCpuTime,
-                  cpuStep / gpuStep);
-    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gpu_propagation_bench: %s\n", e.what());
     return 1;

@@ -3,8 +3,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <functional>
 #include <string>
+#include <thread>
 
 #include "volume/error.h"
 #include "volume/sh.h"
@@ -12,12 +14,21 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 7;  // see the bindings of shaders/lpv_propagate.comp
+// Bindings of shaders/lpv_step_common.glsl and lpv_reduce.comp.
+constexpr std::uint32_t kBindings = 11;
+constexpr bool kTexelBinding[kBindings] = {true, false, false, true, true, false, false, false, false, true, false};
 constexpr VkDeviceSize kVec4 = 4 * sizeof(float);
 constexpr VkDeviceSize kFieldVec4PerCell = 3;   // one vec4 of (c0, c1x, c1y, c1z) per channel
 constexpr VkDeviceSize kFactorVec4PerCell = 2;  // (dc.rgb, active), (linear.rgb, 0)
+constexpr VkDeviceSize kEnergyRowBytes = SSLPV_ENERGY_FLOATS * sizeof(float);
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+constexpr VkBufferUsageFlags kField = kStorage | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+// Tile rows picked automatically, and the measured cost of a covered cell with 8 rows
+// relative to 4 rows on lavapipe (64^3 cube, sphere and shell, bench/gpu_propagation_bench
+// --rows 4|8: 0.87-0.92; fewer halo rows per tile against more covered cells).
+constexpr int kNarrowRows = 4, kWideRows = 8;
+constexpr double kWideRowCost = 0.9;
 
 glm::dvec3 gridPower(const ShGrid& grid) {
   glm::dvec3 power(0.0);
@@ -31,18 +42,131 @@ glm::dvec3 gridPower(const ShGrid& grid) {
 
 void requireFrame(const ShGrid& grid, const GridFrame& frame, const char* what) {
   if (grid.frame.dims != frame.dims)
-    throw GpuError(std::string("GpuPropagator::run: ") + what + " grid is not on the propagator's frame");
+    throw GpuError(std::string("GpuPropagator: ") + what + " grid is not on the propagator's frame");
   for (const std::vector<float>& plane : grid.planes)
     if (plane.size() != frame.cellCount())
-      throw GpuError(std::string("GpuPropagator::run: ") + what + " grid planes do not match its frame");
+      throw GpuError(std::string("GpuPropagator: ") + what + " grid planes do not match its frame");
 }
 
-/// Cells along z per workgroup: enough workgroups for every core of the device (lavapipe
-/// runs one workgroup per thread), but long columns, since each chunk reloads 2 slices.
-int autoZChunk(const VulkanDevice& device, int groupsXY, int dimsZ) {
-  const int wanted = device.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 16 : 256;
-  const int chunks = std::clamp(wanted / std::max(1, groupsXY), 1, std::max(1, dimsZ / 8));
-  return (dimsZ + chunks - 1) / chunks;
+/// The kernel keeps a tile's x neighbours in one subgroup: it needs shuffles and sums in
+/// compute shaders, and subgroups of at least a tile's width.
+void requireSubgroups(const VulkanDevice& device) {
+  VkPhysicalDeviceSubgroupProperties subgroup{};
+  subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+  VkPhysicalDeviceProperties2 properties{};
+  properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  properties.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(device.physicalDevice(), &properties);
+  constexpr VkSubgroupFeatureFlags needed = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT |
+                                            VK_SUBGROUP_FEATURE_SHUFFLE_RELATIVE_BIT |
+                                            VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  if (subgroup.subgroupSize < SSLPV_TILE_X || !(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
+      (subgroup.supportedOperations & needed) != needed)
+    throw GpuError("GPU propagation needs compute subgroups of at least " + std::to_string(SSLPV_TILE_X) +
+                   " lanes with shuffle and arithmetic operations; " + device.name() + " has " +
+                   std::to_string(subgroup.subgroupSize) + " lanes");
+}
+
+DescriptorSetLayout makeSetLayout(const VulkanDevice& device) {
+  VkDescriptorSetLayoutBinding bindings[kBindings]{};
+  for (std::uint32_t i = 0; i < kBindings; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType =
+        kTexelBinding[i] ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  info.bindingCount = kBindings;
+  info.pBindings = bindings;
+  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+  SSLPV_VK_CHECK(vkCreateDescriptorSetLayout(device.handle(), &info, nullptr, &layout));
+  return DescriptorSetLayout(device.handle(), layout);
+}
+
+VkBufferView makeTexelView(const VulkanDevice& device, const Buffer& buffer) {
+  VkBufferViewCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+  info.buffer = buffer.handle();
+  info.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  info.range = VK_WHOLE_SIZE;
+  VkBufferView view = VK_NULL_HANDLE;
+  SSLPV_VK_CHECK(vkCreateBufferView(device.handle(), &info, nullptr, &view));
+  return view;
+}
+
+/// Threads that run a dispatch's workgroups: lavapipe's compute pool has LP_NUM_THREADS
+/// or one per core; a GPU has far more lanes than items, so 1 disables balancing.
+std::size_t workerThreads(const VulkanDevice& device) {
+  if (device.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return 1;
+  if (const char* env = std::getenv("LP_NUM_THREADS")) return std::max(1, std::atoi(env));
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+/// Orders items for lavapipe's compute pool, which splits a dispatch STATICALLY: with T
+/// threads, each takes one run of N / T consecutive workgroups, then the N % T left take
+/// one each. Dealing the items, longest first, to T equal-count bins in snake order
+/// balances the runs' work; each bin keeps raster order, so a thread's consecutive tiles
+/// share halo rows in its cache.
+std::vector<LpvItem> balanceItems(std::vector<LpvItem> items, std::size_t threads) {
+  const std::size_t perBin = items.size() / threads;
+  if (threads < 2 || perBin == 0) return items;
+  std::vector<std::size_t> order(items.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return items[a].zEnd - items[a].zBegin > items[b].zEnd - items[b].zBegin;
+  });
+  std::vector<std::vector<std::size_t>> bins(threads);
+  std::size_t next = 0;
+  for (std::size_t round = 0; round < perBin; ++round)
+    for (std::size_t k = 0; k < threads; ++k) bins[round % 2 ? threads - 1 - k : k].push_back(order[next++]);
+  std::vector<LpvItem> balanced;
+  balanced.reserve(items.size());
+  for (std::vector<std::size_t>& bin : bins) {
+    std::sort(bin.begin(), bin.end());  // raster order: items were built tile by tile
+    for (std::size_t i : bin) balanced.push_back(items[i]);
+  }
+  for (; next < order.size(); ++next) balanced.push_back(items[order[next]]);  // the shortest
+  return balanced;
+}
+
+/// Makes compute writes visible to every later read (shading, copies, the host).
+void toLaterReadsBarrier(VkCommandBuffer cmd) {
+  VkMemoryBarrier barrier{};
+  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                       VK_PIPELINE_STAGE_ALL_COMMANDS_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                       nullptr);
+}
+
+/// Per tile of SSLPV_TILE_X x rows cells and slice: does it hold an active cell? Indexed
+/// (z * tilesY + tileY) * tilesX + tileX.
+std::vector<unsigned char> occupiedSlabs(const GridFrame& frame, const StepFactors& factors, int rows) {
+  const glm::ivec3 d = frame.dims;
+  const int tilesX = (d.x + SSLPV_TILE_X - 1) / SSLPV_TILE_X, tilesY = (d.y + rows - 1) / rows;
+  std::vector<unsigned char> slab(std::size_t(tilesX) * tilesY * std::max(d.z, 0), 0);
+  tbb::parallel_for(0, std::max(d.z, 0), [&](int z) {
+    for (int y = 0; y < d.y; ++y) {
+      if (!factors.rowActive[std::size_t(z) * d.y + y]) continue;
+      for (int x = 0; x < d.x; ++x)
+        if (factors.active[frame.index(x, y, z)])
+          slab[(std::size_t(z) * tilesY + y / rows) * tilesX + x / SSLPV_TILE_X] = 1;
+    }
+  });
+  return slab;
+}
+
+/// Wide tiles re-read fewer halo rows, narrow ones cover fewer empty cells around a thin
+/// or curved object: the cheaper by covered cells and the measured cost ratio.
+int chooseTileRows(const GridFrame& frame, const StepFactors& factors) {
+  const auto covered = [&](int rows) {
+    const std::vector<unsigned char> slab = occupiedSlabs(frame, factors, rows);
+    return double(std::count(slab.begin(), slab.end(), 1)) * SSLPV_TILE_X * rows;
+  };
+  return kWideRowCost * covered(kWideRows) <= covered(kNarrowRows) ? kWideRows : kNarrowRows;
 }
 
 }  // namespace
@@ -51,76 +175,167 @@ GpuPropagator::GpuPropagator(const VulkanDevice& device, const GridFrame& frame,
                              const GpuPropagatorOptions& options)
     : device_(device), frame_(frame), options_(options), commands_(device) {
   const VkPhysicalDeviceLimits& limits = device.properties().limits;
-  const auto sharedBytes = [](int x, int y) { return std::uint64_t(x + 2) * (y + 2) * 3 * kVec4; };
-  if (options_.groupX <= 0 || options_.groupY <= 0) {
-    // Wide rows make long contiguous runs in memory; lanes past the grid's edge would idle.
-    options_.groupX = 8;
-    while (options_.groupX < 64 && options_.groupX < frame.dims.x) options_.groupX *= 2;
-    options_.groupY = std::max(4, 128 / options_.groupX);
-    while (options_.groupX > 8 && sharedBytes(options_.groupX, options_.groupY) > limits.maxComputeSharedMemorySize) {
-      options_.groupX /= 2;
-      options_.groupY = std::max(4, 128 / options_.groupX);
-    }
-  }
-  const int groupX = options_.groupX, groupY = options_.groupY;
-  if (groupX < 4 || groupY < 4 || options.stepsPerSubmission < 1)
-    throw GpuError("GpuPropagatorOptions: workgroups need x, y >= 4 and stepsPerSubmission >= 1");
-  if (sharedBytes(groupX, groupY) > limits.maxComputeSharedMemorySize ||
-      std::uint64_t(groupX) * groupY > limits.maxComputeWorkGroupInvocations)
-    throw GpuError("GpuPropagatorOptions: workgroup " + std::to_string(groupX) + "x" + std::to_string(groupY) +
-                   " exceeds the device's compute limits");
+  const bool factorsFit = factors.active.size() == frame.cellCount() &&
+                          factors.rowActive.size() == std::size_t(frame.dims.y) * frame.dims.z;
+  if (options_.tileRows <= 0)  // factors that do not fit are rejected by setFactors() below
+    options_.tileRows = factorsFit ? chooseTileRows(frame, factors) : kWideRows;
+  if (options_.tileRows > 32 || options_.stepsPerSubmission < 1 || options_.zChunk < 0)
+    throw GpuError("GpuPropagatorOptions: tileRows must be 1..32, stepsPerSubmission >= 1, zChunk >= 0");
 
-  const std::size_t cells = frame.cellCount();
-  const VkDeviceSize fieldBytes = std::max<VkDeviceSize>(cells, 1) * kFieldVec4PerCell * kVec4;
-  if (fieldBytes > limits.maxStorageBufferRange)
+  // The private grids are padded to whole tiles; they are at least as large as the shared ones.
+  tilesX_ = (std::max(frame.dims.x, 1) + SSLPV_TILE_X - 1) / SSLPV_TILE_X;
+  tilesY_ = (std::max(frame.dims.y, 1) + options_.tileRows - 1) / options_.tileRows;
+  const std::size_t tiledCells = std::size_t(tilesX_) * SSLPV_TILE_X * tilesY_ * options_.tileRows * std::max(frame.dims.z, 1);
+  const VkDeviceSize fieldBytes = std::max<std::size_t>(frame.cellCount(), 1) * kFieldVec4PerCell * kVec4;
+  const VkDeviceSize tiledBytes = tiledCells * kFieldVec4PerCell * kVec4;
+  if (tiledBytes > limits.maxStorageBufferRange || tiledCells * kFieldVec4PerCell > limits.maxTexelBufferElements)
     throw ResourceError("LPV grid " + std::to_string(frame.dims.x) + "x" + std::to_string(frame.dims.y) + "x" +
-                        std::to_string(frame.dims.z) + " needs " + std::to_string(fieldBytes >> 20) +
+                        std::to_string(frame.dims.z) + " needs " + std::to_string(tiledBytes >> 20) +
                         " MiB per light field, more than the Vulkan device's storage-buffer range of " +
                         std::to_string(limits.maxStorageBufferRange >> 20) + " MiB");
+  requireSubgroups(device);
 
-  const auto groupsAlong = [](int count, int perGroup) {
-    return std::uint32_t((std::max(1, count) + perGroup - 1) / perGroup);
-  };
-  groups_[0] = groupsAlong(frame.dims.x, groupX);
-  groups_[1] = groupsAlong(frame.dims.y, groupY);
-  zChunk_ =
-      options.zChunk > 0 ? options.zChunk : autoZChunk(device, int(groups_[0] * groups_[1]), std::max(1, frame.dims.z));
-  groups_[2] = std::uint32_t((std::max(1, frame.dims.z) + zChunk_ - 1) / zChunk_);
-  for (int axis = 0; axis < 3; ++axis)
-    if (groups_[axis] > limits.maxComputeWorkGroupCount[axis])
-      throw ResourceError("LPV grid needs more workgroups than the Vulkan device dispatches");
-  partialRows_ = groups_[0] * groups_[1] * groups_[2];  // one row of power sums per workgroup
-
-  setLayout_ = makeStorageBufferSetLayout(device, kBindings);
-  propagatePipeline_ = ComputePipeline(device, spirv::lpv_propagate_comp(), setLayout_.get(), sizeof(LpvStepPush),
-                                       {std::uint32_t(groupX), std::uint32_t(groupY)});
-  reducePipeline_ = ComputePipeline(device, spirv::lpv_reduce_comp(), setLayout_.get(), sizeof(LpvStepPush));
-  accumulatePipeline_ = ComputePipeline(device, spirv::lpv_accumulate_comp(), setLayout_.get(), sizeof(LpvStepPush));
-
-  for (Buffer& field : fields_) field = Buffer(device, fieldBytes, kStorage, MemoryUse::Device);
-  accumulated_ = Buffer(device, fieldBytes, kStorage, MemoryUse::Device);
-  factors_ = Buffer(device, std::max<VkDeviceSize>(cells, 1) * kFactorVec4PerCell * kVec4, kStorage, MemoryUse::Device);
-  partials_ =
-      Buffer(device, VkDeviceSize(partialRows_) * SSLPV_ENERGY_FLOATS * sizeof(float), kStorage, MemoryUse::Device);
-  control_ = Buffer(device, sizeof(LpvControl), kStorage, MemoryUse::Host);
-  stepTotals_ = Buffer(device, VkDeviceSize(options.stepsPerSubmission) * SSLPV_ENERGY_FLOATS * sizeof(float), kStorage,
-                       MemoryUse::Host);
-  staging_ = options.forceStaging || !fields_[0].mapped() || !accumulated_.mapped() || !factors_.mapped();
-  if (staging_) stagingBuffer_ = Buffer(device, fieldBytes, kStorage, MemoryUse::Host);
-
-  sets_ = StorageBufferSets(device, setLayout_.get(), kBindings, 2);
-  for (std::size_t k = 0; k < 2; ++k) {
-    sets_.write(k, 0, fields_[k]);
-    sets_.write(k, 1, fields_[1 - k]);
-    sets_.write(k, 2, accumulated_);
-    sets_.write(k, 3, factors_);
-    sets_.write(k, 4, partials_);
-    sets_.write(k, 5, control_);
-    sets_.write(k, 6, stepTotals_);
+  setLayout_ = makeSetLayout(device);
+  const auto rows = std::uint32_t(options_.tileRows);
+  for (std::uint32_t variant = 0; variant < 2; ++variant) {
+    propagatePipelines_[variant] =
+        ComputePipeline(device, spirv::lpv_propagate_comp(), setLayout_.get(), sizeof(LpvStepPush), {rows, variant});
+    finishPipelines_[variant] =
+        ComputePipeline(device, spirv::lpv_accumulate_comp(), setLayout_.get(), sizeof(LpvStepPush), {rows, variant});
   }
-  // Per submission: a start stamp, then one after each propagation and each reduction.
-  timestamps_ = TimestampQueries(device, 1 + 2 * std::uint32_t(options.stepsPerSubmission));
+  reducePipeline_ = ComputePipeline(device, spirv::lpv_reduce_comp(), setLayout_.get(), sizeof(LpvStepPush));
+  importPipeline_ = ComputePipeline(device, spirv::lpv_import_comp(), setLayout_.get(), sizeof(LpvStepPush), {rows});
+
+  linearSource_ = Buffer(device, fieldBytes, kField, MemoryUse::Device);
+  linearAccumulated_ = Buffer(device, fieldBytes, kField, MemoryUse::Device);
+  for (Buffer& field : tiled_) field = Buffer(device, tiledBytes, kField, MemoryUse::Device);
+  tiledAccumulated_ = Buffer(device, tiledBytes, kField, MemoryUse::Device);
+  factors_ = Buffer(device, tiledCells * kFactorVec4PerCell * kVec4, kField, MemoryUse::Device);
+  control_ = Buffer(device, sizeof(LpvControl), kStorage, MemoryUse::Host);
+  stepTotals_ = Buffer(device, VkDeviceSize(options_.stepsPerSubmission) * kEnergyRowBytes, kStorage, MemoryUse::Host);
+  staging_ = options_.forceStaging || !tiled_[0].mapped() || !linearSource_.mapped() || !factors_.mapped();
+  if (staging_) stagingBuffer_ = Buffer(device, std::max(tiledBytes, factors_.size()), kStorage, MemoryUse::Host);
+  for (int k = 0; k < 2; ++k) tiledViews_[k] = BufferView(device.handle(), makeTexelView(device, tiled_[k]));
+  tiledAccumulatedView_ = BufferView(device.handle(), makeTexelView(device, tiledAccumulated_));
+  factorsView_ = BufferView(device.handle(), makeTexelView(device, factors_));
+  linearSourceView_ = BufferView(device.handle(), makeTexelView(device, linearSource_));
+
+  const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2 * 4},
+                                         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * 7}};
+  VkDescriptorPoolCreateInfo poolInfo{};
+  poolInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  poolInfo.maxSets = 2;
+  poolInfo.poolSizeCount = 2;
+  poolInfo.pPoolSizes = sizes;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  SSLPV_VK_CHECK(vkCreateDescriptorPool(device.handle(), &poolInfo, nullptr, &pool));
+  pool_ = DescriptorPool(device.handle(), pool);
+  const VkDescriptorSetLayout layouts[2] = {setLayout_.get(), setLayout_.get()};
+  VkDescriptorSetAllocateInfo allocate{};
+  allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  allocate.descriptorPool = pool;
+  allocate.descriptorSetCount = 2;
+  allocate.pSetLayouts = layouts;
+  SSLPV_VK_CHECK(vkAllocateDescriptorSets(device.handle(), &allocate, sets_));
+
+  // Per submission: a start stamp, one after each propagation and each reduction.
+  timestamps_ = TimestampQueries(device, 1 + 2 * std::uint32_t(options_.stepsPerSubmission));
   setFactors(factors);
+}
+
+void GpuPropagator::buildItems(const StepFactors& factors) {
+  const glm::ivec3 d = frame_.dims;
+  const int rows = options_.tileRows;
+  const int tilesX = tilesX_, tilesY = tilesY_;
+  const std::vector<unsigned char> slab = occupiedSlabs(frame_, factors, rows);
+  const auto occupied = std::size_t(std::count(slab.begin(), slab.end(), 1));
+  activeCells_ = std::size_t(std::count(factors.active.begin(), factors.active.end(), 1));
+
+  // Enough items for every worker of the device, without splitting runs so finely that
+  // the 2 halo slices each piece re-reads dominate.
+  const std::size_t workers = workerThreads(device_);
+  zChunk_ = options_.zChunk > 0 ? options_.zChunk
+                                : int(std::clamp<std::size_t>((occupied + 8 * workers - 1) / (8 * workers), 4,
+                                                              std::size_t(std::max(d.z, 4))));
+  std::vector<LpvItem> items;
+  coveredCells_ = 0;
+  for (int ty = 0; ty < tilesY; ++ty)
+    for (int tx = 0; tx < tilesX; ++tx)
+      for (int z = 0; z < d.z;) {
+        if (!slab[(std::size_t(z) * tilesY + ty) * tilesX + tx]) {
+          ++z;
+          continue;
+        }
+        int end = z;
+        while (end < d.z && slab[(std::size_t(end) * tilesY + ty) * tilesX + tx]) ++end;
+        // Split the run into near-equal pieces of at most zChunk_ slices.
+        const int pieces = (end - z + zChunk_ - 1) / zChunk_;
+        for (int p = 0; p < pieces; ++p) {
+          const int begin = z + (end - z) * p / pieces, stop = z + (end - z) * (p + 1) / pieces;
+          items.push_back(LpvItem{std::uint32_t(tx * SSLPV_TILE_X), std::uint32_t(ty * rows), std::uint32_t(begin),
+                                  std::uint32_t(stop)});
+          const int width = std::min(SSLPV_TILE_X, d.x - tx * SSLPV_TILE_X), height = std::min(rows, d.y - ty * rows);
+          coveredCells_ += std::size_t(width) * height * (stop - begin);
+        }
+        z = end;
+      }
+  items = balanceItems(std::move(items), workerThreads(device_));
+  if (items.size() > device_.properties().limits.maxComputeWorkGroupCount[0])
+    throw ResourceError("LPV grid needs more work items than the Vulkan device dispatches at once");
+
+  const bool itemsChanged = items.size() != items_.size() ||
+                            !std::equal(items.begin(), items.end(), items_.begin(), [](const LpvItem& a, const LpvItem& b) {
+                              return a.x == b.x && a.y == b.y && a.zBegin == b.zBegin && a.zEnd == b.zEnd;
+                            });
+  items_ = std::move(items);
+  itemCount_ = items_.size();
+  const std::size_t capacity = std::max<std::size_t>(itemCount_, 1);
+  if (itemBuffer_.size() < capacity * sizeof(LpvItem)) {
+    itemBuffer_ = Buffer(device_, capacity * sizeof(LpvItem), kStorage, MemoryUse::Host);
+    partials_ = Buffer(device_, capacity * kEnergyRowBytes, kStorage, MemoryUse::Device);
+    writeDescriptors();
+  }
+  std::copy(items_.begin(), items_.end(), itemBuffer_.mappedAs<LpvItem>());
+
+  // Cells outside the items must read as zero: clear whatever earlier items left there.
+  if (itemsChanged) {
+    VkCommandBuffer cmd = commands_.begin();
+    for (const Buffer* buffer : {&tiled_[0], &tiled_[1], &tiledAccumulated_, &linearAccumulated_})
+      vkCmdFillBuffer(cmd, buffer->handle(), 0, VK_WHOLE_SIZE, 0);
+    toLaterReadsBarrier(cmd);
+    commands_.submitAndWait();
+    tiledAccumulatedClean_ = linearAccumulatedClean_ = true;
+  }
+}
+
+void GpuPropagator::writeDescriptors() {
+  for (int k = 0; k < 2; ++k) {
+    const VkBufferView views[kBindings] = {tiledViews_[k].get(), VK_NULL_HANDLE,  VK_NULL_HANDLE,
+                                           tiledAccumulatedView_.get(), factorsView_.get(), VK_NULL_HANDLE,
+                                           VK_NULL_HANDLE,       VK_NULL_HANDLE,  VK_NULL_HANDLE,
+                                           linearSourceView_.get(), VK_NULL_HANDLE};
+    const Buffer* buffers[kBindings] = {nullptr,     &tiled_[1 - k], &tiledAccumulated_, nullptr,
+                                        nullptr,     &itemBuffer_,   &partials_,         &control_,
+                                        &stepTotals_, nullptr,       &linearAccumulated_};
+    VkDescriptorBufferInfo infos[kBindings]{};
+    VkWriteDescriptorSet writes[kBindings]{};
+    for (std::uint32_t b = 0; b < kBindings; ++b) {
+      VkWriteDescriptorSet& w = writes[b];
+      w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+      w.dstSet = sets_[k];
+      w.dstBinding = b;
+      w.descriptorCount = 1;
+      if (kTexelBinding[b]) {
+        w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+        w.pTexelBufferView = &views[b];
+      } else {
+        infos[b] = VkDescriptorBufferInfo{buffers[b]->handle(), 0, VK_WHOLE_SIZE};
+        w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        w.pBufferInfo = &infos[b];
+      }
+    }
+    vkUpdateDescriptorSets(device_.handle(), kBindings, writes, 0, nullptr);
+  }
 }
 
 void GpuPropagator::setFactors(const StepFactors& factors) {
@@ -128,16 +343,22 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
   for (int ch = 0; ch < 3; ++ch)
     if (factors.dc[ch].size() != cells || factors.linear[ch].size() != cells)
       throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
-  if (factors.active.size() != cells) throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
+  if (factors.active.size() != cells || factors.rowActive.size() != std::size_t(frame_.dims.y) * frame_.dims.z)
+    throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
   float* out = staging_ ? stagingBuffer_.mappedAs<float>() : factors_.mappedAs<float>();
-  tbb::parallel_for(std::size_t(0), cells, [&](std::size_t i) {
-    float* cell = out + i * kFactorVec4PerCell * 4;
-    for (int ch = 0; ch < 3; ++ch) {
-      cell[ch] = factors.dc[ch][i];
-      cell[4 + ch] = factors.linear[ch][i];
-    }
-    cell[3] = factors.active[i] ? 1.0f : 0.0f;
-    cell[7] = 0.0f;
+  const glm::ivec3 d = frame_.dims;
+  tbb::parallel_for(0, d.z, [&](int z) {
+    for (int y = 0; y < d.y; ++y)
+      for (int x = 0; x < d.x; ++x) {
+        const std::size_t i = frame_.index(x, y, z);
+        float* cell = out + tiledIndex(x, y, z) * kFactorVec4PerCell * 4;
+        for (int ch = 0; ch < 3; ++ch) {
+          cell[ch] = factors.dc[ch][i];
+          cell[4 + ch] = factors.linear[ch][i];
+        }
+        cell[3] = factors.active[i] ? 1.0f : 0.0f;
+        cell[7] = 0.0f;
+      }
   });
   if (staging_) {
     VkCommandBuffer cmd = commands_.begin();
@@ -145,125 +366,153 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
     vkCmdCopyBuffer(cmd, stagingBuffer_.handle(), factors_.handle(), 1, &region);
     commands_.submitAndWait();
   }
+  active_ = factors.active;
+  buildItems(factors);
 }
 
-void GpuPropagator::upload(const ShGrid& grid, const Buffer& target) {
-  float* out = staging_ ? stagingBuffer_.mappedAs<float>() : target.mappedAs<float>();
-  const std::size_t cells = frame_.cellCount();
-  tbb::parallel_for(std::size_t(0), cells, [&](std::size_t i) {
-    for (int k = 0; k < ShGrid::kPlanes; ++k) out[i * 12 + k] = grid.planes[k][i];  // plane = channel*4 + sh
+std::size_t GpuPropagator::tiledIndex(int x, int y, int z) const {
+  return std::size_t(SSLPV_TILED_INDEX(std::size_t(x), std::size_t(y), std::size_t(z), std::size_t(tilesX_),
+                                       std::size_t(options_.tileRows), std::size_t(frame_.dims.z)));
+}
+
+void GpuPropagator::transfer(const ShGrid* from, ShGrid* to, const Buffer& device, bool tiled, bool activeOnly) {
+  const ShGrid& grid = from ? *from : *to;
+  requireFrame(grid, frame_, from ? "uploaded" : "downloaded");
+  if (to && staging_) {
+    VkCommandBuffer cmd = commands_.begin();
+    deviceWritesBarrier(cmd);
+    timestamps_.reset(cmd);
+    timestamps_.write(cmd, 0);
+    const VkBufferCopy region{0, 0, device.size()};
+    vkCmdCopyBuffer(cmd, device.handle(), stagingBuffer_.handle(), 1, &region);
+    toHostBarrier(cmd);
+    timestamps_.write(cmd, 1);
+    commands_.submitAndWait();
+    timings_.readbackMs += timestamps_.readMilliseconds(2)[1];
+  }
+  float* memory = staging_ ? stagingBuffer_.mappedAs<float>() : device.mappedAs<float>();
+  const glm::ivec3 d = frame_.dims;
+  tbb::parallel_for(0, d.z, [&](int z) {
+    for (int y = 0; y < d.y; ++y)
+      for (int x = 0; x < d.x; ++x) {
+        const std::size_t i = frame_.index(x, y, z);
+        float* cell = memory + (tiled ? tiledIndex(x, y, z) : i) * 12;  // plane = channel*4 + sh
+        if (to) {
+          for (int k = 0; k < ShGrid::kPlanes; ++k) to->planes[k][i] = cell[k];
+        } else {
+          const bool keep = !activeOnly || active_[i];
+          for (int k = 0; k < ShGrid::kPlanes; ++k) cell[k] = keep ? from->planes[k][i] : 0.0f;
+        }
+      }
   });
-  if (staging_) {
+  if (from && staging_) {
     VkCommandBuffer cmd = commands_.begin();
     timestamps_.reset(cmd);
     timestamps_.write(cmd, 0);
-    const VkBufferCopy region{0, 0, target.size()};
-    vkCmdCopyBuffer(cmd, stagingBuffer_.handle(), target.handle(), 1, &region);
+    const VkBufferCopy region{0, 0, device.size()};
+    vkCmdCopyBuffer(cmd, stagingBuffer_.handle(), device.handle(), 1, &region);
     timestamps_.write(cmd, 1);
     commands_.submitAndWait();
     timings_.uploadMs += timestamps_.readMilliseconds(2)[1];
   }
 }
 
-void GpuPropagator::download(const Buffer& source, ShGrid& grid) {
-  if (staging_) {
-    VkCommandBuffer cmd = commands_.begin();
-    deviceWritesBarrier(cmd);
-    timestamps_.reset(cmd);
-    timestamps_.write(cmd, 0);
-    const VkBufferCopy region{0, 0, source.size()};
-    vkCmdCopyBuffer(cmd, source.handle(), stagingBuffer_.handle(), 1, &region);
-    toHostBarrier(cmd);
-    timestamps_.write(cmd, 1);
-    commands_.submitAndWait();
-    timings_.readbackMs += timestamps_.readMilliseconds(2)[1];
-  }
-  const float* in = staging_ ? stagingBuffer_.mappedAs<const float>() : source.mappedAs<const float>();
-  tbb::parallel_for(std::size_t(0), frame_.cellCount(), [&](std::size_t i) {
-    for (int k = 0; k < ShGrid::kPlanes; ++k) grid.planes[k][i] = in[i * 12 + k];
-  });
+void GpuPropagator::uploadField(const ShGrid& grid, const Buffer& target, bool activeOnly) {
+  if (&target != &linearSource_ && &target != &linearAccumulated_)
+    throw GpuError("GpuPropagator::uploadField: the target must be sourceField() or accumulated()");
+  transfer(&grid, nullptr, target, false, activeOnly);
+  if (&target == &linearAccumulated_) linearAccumulatedClean_ = false;
 }
+
+void GpuPropagator::downloadField(const Buffer& source, ShGrid& grid) {
+  if (&source != &linearSource_ && &source != &linearAccumulated_)
+    throw GpuError("GpuPropagator::downloadField: the source must be sourceField() or accumulated()");
+  transfer(nullptr, &grid, source, false, false);
+}
+
+void GpuPropagator::downloadLastField(ShGrid& grid) { transfer(nullptr, &grid, tiled_[stepsRun() % 2], true, false); }
+
+int GpuPropagator::stepsRun() const { return control_.mappedAs<const LpvControl>()->stepsRun; }
 
 LpvStepPush GpuPropagator::stepPush(const PropagationOptions& options) const {
   LpvStepPush push{};
   push.dimsX = frame_.dims.x;
   push.dimsY = frame_.dims.y;
   push.dimsZ = frame_.dims.z;
-  push.zChunk = zChunk_;
-  push.partialRows = int(partialRows_);
+  push.itemCount = int(itemCount_);
   push.autoSteps = options.autoSteps ? 1 : 0;
   push.autoTolerance = float(options.autoTolerance);
   return push;
 }
 
-void GpuPropagator::recordSteps(VkCommandBuffer cmd, int firstStep, int count, const PropagationOptions& options) {
+void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, int count,
+                                const PropagationOptions& options, bool timestamps) {
   LpvStepPush push = stepPush(options);
-  deviceWritesBarrier(cmd);  // uploads, fills and earlier steps
-  timestamps_.reset(cmd);
-  timestamps_.write(cmd, 0);
+  const auto groups = std::uint32_t(itemCount_);
   for (int s = 0; s < count; ++s) {
     const int step = firstStep + s;
-    push.stepSlot = s;
-    // Odd steps accumulate their sources and results: step 0's sources (the injected
-    // light) are already in, and accumulateLastStep() adds a result left over at the end.
-    push.accumulate = step % 2;
-    propagatePipeline_.bind(cmd, sets_.set(std::size_t(step) % 2), &push, sizeof(push));
-    vkCmdDispatch(cmd, groups_[0], groups_[1], groups_[2]);
+    push.stepSlot = s % options_.stepsPerSubmission;
+    push.initPower = mode == Mode::Device && step == 0 ? 1 : 0;
+    // Every other step accumulates its sources and results. From the host, the injected
+    // light (step 0's sources) is already in, so odd steps do; on the device, step 0
+    // starts the accumulated grid with both, then even steps add.
+    if (mode == Mode::Host) push.accumulate = step % 2 == 1 ? 1 : 0;
+    if (mode == Mode::Device) push.accumulate = step == 0 ? 2 : step % 2 == 0 ? 1 : 0;
+    propagatePipelines_[push.accumulate != 0].bind(cmd, sets_[step % 2], &push, sizeof(push));
+    if (groups > 0) vkCmdDispatch(cmd, groups, 1, 1);
     computeToComputeBarrier(cmd);
-    timestamps_.write(cmd, 1 + 2 * std::uint32_t(s));
-    reducePipeline_.bind(cmd, sets_.set(0), &push, sizeof(push));
+    if (timestamps) timestamps_.write(cmd, 1 + 2 * std::uint32_t(s));
+    reducePipeline_.bind(cmd, sets_[0], &push, sizeof(push));
     vkCmdDispatch(cmd, 1, 1, 1);
     computeToComputeBarrier(cmd);
-    timestamps_.write(cmd, 2 + 2 * std::uint32_t(s));
+    if (timestamps) timestamps_.write(cmd, 2 + 2 * std::uint32_t(s));
   }
-  toHostBarrier(cmd);
 }
 
-void GpuPropagator::accumulateLastStep(int stepsRun) {
-  if (stepsRun % 2 == 0) return;  // the last step (odd index) accumulated itself
+void GpuPropagator::recordFinish(VkCommandBuffer cmd, Mode mode, int stepLimit, const PropagationOptions& options) {
+  if (itemCount_ == 0) return;
+  LpvStepPush push = stepPush(options);
+  // The last step is missing from the accumulated grid when it did not accumulate: from
+  // the host odd steps accumulate, so the last one (index stepsRun - 1) is missing when
+  // stepsRun is odd and its light is in tiled_[1]; on the device even steps do, so it is
+  // missing when stepsRun is even and its light is in tiled_[0]. Set k reads tiled_[k].
+  push.leftoverParity = mode == Mode::Host ? 1 : 0;
+  push.stepLimit = stepLimit;
+  finishPipelines_[mode == Mode::Device].bind(cmd, sets_[mode == Mode::Host ? 1 : 0], &push, sizeof(push));
+  vkCmdDispatch(cmd, std::uint32_t(itemCount_), 1, 1);
+  computeToComputeBarrier(cmd);
+}
+
+void GpuPropagator::prepareDeviceRun(VkCommandBuffer cmd) {
+  vkCmdFillBuffer(cmd, control_.handle(), 0, VK_WHOLE_SIZE, 0);  // not stopped, no steps, no power
+  // The first step and the final copy write only inside the work items.
+  if (!tiledAccumulatedClean_) vkCmdFillBuffer(cmd, tiledAccumulated_.handle(), 0, VK_WHOLE_SIZE, 0);
+  if (!linearAccumulatedClean_) vkCmdFillBuffer(cmd, linearAccumulated_.handle(), 0, VK_WHOLE_SIZE, 0);
+  tiledAccumulatedClean_ = linearAccumulatedClean_ = true;
+  deviceWritesBarrier(cmd);  // injection's writes and the fills
+  if (itemCount_ == 0) return;
   const LpvStepPush push = stepPush(PropagationOptions{});
-  VkCommandBuffer cmd = commands_.begin();
-  deviceWritesBarrier(cmd);
-  // Set k reads fields_[k % 2], which after stepsRun steps holds the last result.
-  accumulatePipeline_.bind(cmd, sets_.set(std::size_t(stepsRun) % 2), &push, sizeof(push));
-  vkCmdDispatch(cmd, std::uint32_t((frame_.cellCount() + 63) / 64), 1, 1);
-  toHostBarrier(cmd);
-  commands_.submitAndWait();
+  importPipeline_.bind(cmd, sets_[1], &push, sizeof(push));  // set 1 writes tiled_[0]
+  vkCmdDispatch(cmd, std::uint32_t(itemCount_), 1, 1);
+  computeToComputeBarrier(cmd);
 }
 
-PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const PropagationOptions& options) {
-  requireFrame(field, frame_, "field");
-  requireFrame(accumulated, frame_, "accumulated");
-  timings_ = GpuPropagationTimings{};
+PropagationResult GpuPropagator::execute(Mode mode, const PropagationOptions& options) {
   PropagationResult result;
-  result.initialPower = gridPower(field);
-  // The injected light counts as step 0 of the sum, exactly as on the CPU.
-  for (int k = 0; k < ShGrid::kPlanes; ++k)
-    std::transform(accumulated.planes[k].begin(), accumulated.planes[k].end(), field.planes[k].begin(),
-                   accumulated.planes[k].begin(), std::plus<float>());
   const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
-  if (frame_.dims.x < 3 || frame_.dims.y < 3 || frame_.dims.z < 3 || maxSteps <= 0) return result;
-
-  upload(field, fields_[0]);
-  upload(accumulated, accumulated_);
-  // The first step writes only interior cells of fields_[1]: the rest must read as zero,
-  // as the CPU's freshly allocated grid does.
-  {
-    VkCommandBuffer cmd = commands_.begin();
-    vkCmdFillBuffer(cmd, fields_[1].handle(), 0, VK_WHOLE_SIZE, 0);
-    commands_.submitAndWait();
-  }
-  LpvControl& control = *control_.mappedAs<LpvControl>();
-  control = LpvControl{};
-  control.accumulatedPowerR = float(result.initialPower.x);
-  control.accumulatedPowerG = float(result.initialPower.y);
-  control.accumulatedPowerB = float(result.initialPower.z);
-
+  const LpvControl& control = *control_.mappedAs<const LpvControl>();
   int recorded = 0;
   while (recorded < maxSteps && control.stopped == 0) {
     const int count = std::min(options_.stepsPerSubmission, maxSteps - recorded);
     const int stepsBefore = control.stepsRun;
-    recordSteps(commands_.begin(), recorded, count, options);
+    VkCommandBuffer cmd = commands_.begin();
+    if (mode == Mode::Device && recorded == 0) prepareDeviceRun(cmd);
+    deviceWritesBarrier(cmd);  // uploads, fills and earlier submissions
+    timestamps_.reset(cmd);
+    timestamps_.write(cmd, 0);
+    recordSteps(cmd, mode, recorded, count, options, true);
+    recordFinish(cmd, mode, maxSteps, options);
+    toHostBarrier(cmd);
     commands_.submitAndWait();
     recorded += count;
 
@@ -271,6 +520,8 @@ PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const P
     const int ran = control.stepsRun - stepsBefore;
     const std::vector<double> ms = timestamps_.readMilliseconds(1 + 2 * std::uint32_t(count));
     const float* totals = stepTotals_.mappedAs<const float>();
+    if (mode == Mode::Device && stepsBefore == 0 && ran > 0)
+      for (int ch = 0; ch < 3; ++ch) result.initialPower[ch] = double(totals[SSLPV_ENERGY_SOURCE + ch]) * sh::kFluxPerC0;
     for (int s = 0; s < ran; ++s) {
       timings_.propagateMs += ms[1 + 2 * s] - ms[2 * s];
       timings_.reduceMs += ms[2 + 2 * s] - ms[1 + 2 * s];
@@ -290,11 +541,66 @@ PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const P
   }
   result.stepsRun = control.stepsRun;
   timings_.steps = result.stepsRun;
-  accumulateLastStep(result.stepsRun);
-
-  download(fields_[result.stepsRun % 2], field);
-  download(accumulated_, accumulated);
   return result;
+}
+
+PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const PropagationOptions& options) {
+  requireFrame(field, frame_, "field");
+  requireFrame(accumulated, frame_, "accumulated");
+  timings_ = GpuPropagationTimings{};
+  const glm::dvec3 initialPower = gridPower(field);
+  // The injected light counts as step 0 of the sum, exactly as on the CPU.
+  for (int k = 0; k < ShGrid::kPlanes; ++k)
+    std::transform(accumulated.planes[k].begin(), accumulated.planes[k].end(), field.planes[k].begin(),
+                   accumulated.planes[k].begin(), std::plus<float>());
+  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
+  if (frame_.dims.x < 3 || frame_.dims.y < 3 || frame_.dims.z < 3 || maxSteps <= 0) {
+    PropagationResult result;
+    result.initialPower = initialPower;
+    return result;
+  }
+
+  transfer(&field, nullptr, tiled_[0], true, true);
+  transfer(&accumulated, nullptr, tiledAccumulated_, true, false);
+  tiledAccumulatedClean_ = false;
+  LpvControl& control = *control_.mappedAs<LpvControl>();
+  control = LpvControl{};
+  control.accumulatedPowerR = float(initialPower.x);
+  control.accumulatedPowerG = float(initialPower.y);
+  control.accumulatedPowerB = float(initialPower.z);
+  PropagationResult result = execute(Mode::Host, options);
+  result.initialPower = initialPower;
+  transfer(nullptr, &field, tiled_[result.stepsRun % 2], true, false);
+  transfer(nullptr, &accumulated, tiledAccumulated_, true, false);
+  return result;
+}
+
+PropagationResult GpuPropagator::runOnDevice(const PropagationOptions& options) {
+  timings_ = GpuPropagationTimings{};
+  *control_.mappedAs<LpvControl>() = LpvControl{};  // the host loop reads it before the GPU resets it
+  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
+  if (frame_.dims.x < 3 || frame_.dims.y < 3 || frame_.dims.z < 3 || maxSteps <= 0) {
+    VkCommandBuffer cmd = commands_.begin();
+    record(cmd, options);
+    commands_.submitAndWait();
+    return PropagationResult{};
+  }
+  return execute(Mode::Device, options);
+}
+
+void GpuPropagator::record(VkCommandBuffer cmd, const PropagationOptions& options) {
+  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
+  prepareDeviceRun(cmd);
+  if (frame_.dims.x < 3 || frame_.dims.y < 3 || frame_.dims.z < 3 || maxSteps <= 0) {
+    // No step: the accumulated light is the injected light, wherever it is.
+    const VkBufferCopy region{0, 0, linearAccumulated_.size()};
+    vkCmdCopyBuffer(cmd, linearSource_.handle(), linearAccumulated_.handle(), 1, &region);
+    linearAccumulatedClean_ = false;
+  } else {
+    recordSteps(cmd, Mode::Device, 0, maxSteps, options, false);
+    recordFinish(cmd, Mode::Device, maxSteps, options);
+  }
+  toLaterReadsBarrier(cmd);
 }
 
 }  // namespace sslpv::gpu

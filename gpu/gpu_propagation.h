@@ -1,7 +1,10 @@
 #pragma once
 // LPV propagation on the GPU: the twin of sslpv::propagate() (volume/propagate.cpp) with
-// the same contract, steps, auto-step rule and per-step energy bookkeeping.
+// the same contract, steps, auto-step rule and per-step energy bookkeeping, run only over
+// the occupied part of the grid, from host grids (run) or device-resident (runOnDevice,
+// record) between GPU injection and GPU shading.
 #include <cstdint>
+#include <vector>
 
 #include "gpu/compute.h"
 #include "gpu/device.h"
@@ -11,14 +14,15 @@
 namespace sslpv::gpu {
 
 struct GpuPropagatorOptions {
-  /// Workgroup shape (x, y >= 4), the cross-section of the column a workgroup marches
-  /// along z; 0: x as wide as the grid up to 64, y = max(4, 128 / x). Measured on
-  /// lavapipe: 64x4 at 64^3 (37 ms a step on one thread, against 46 for 32x8, 50 for
-  /// 16x16 and 49 for 8x8) and 32x4 at 32^3 (4.8 ms, against 5.4 for 32x8). Narrower
-  /// where the device has less shared memory than the slice needs (19 KiB at 64x4).
-  int groupX = 0, groupY = 0;
-  /// Cells along z one workgroup marches through; 0 picks enough workgroups to keep
-  /// the device's cores busy.
+  /// Rows along y of a work item's tile (tiles are SSLPV_TILE_X = 8 cells along x, one
+  /// invocation per x column keeping the light gathered into its rows of 3 slices in
+  /// registers). 0: 8 or 4, whichever the construction-time factors make cheaper (8
+  /// re-reads fewer halo rows, 4 covers fewer empty cells around thin or curved objects;
+  /// bench --rows measures both).
+  int tileRows = 0;
+  /// Most slices one work item marches through; longer runs of occupied slices are split
+  /// (each piece re-reads 2 halo slices) so that every core of the device gets work.
+  /// 0: from the number of occupied slices and the device's cores.
   int zChunk = 0;
   /// Steps recorded per submission (auto steps stop on the GPU within a submission).
   int stepsPerSubmission = 32;
@@ -26,7 +30,8 @@ struct GpuPropagatorOptions {
   bool forceStaging = false;
 };
 
-/// GPU time of the last run(), from timestamps (0 where the queue has none).
+/// GPU time of the last run() or runOnDevice(), from timestamps (0 where the queue has
+/// none).
 struct GpuPropagationTimings {
   double uploadMs = 0.0;     ///< staging copies to the device (0 when mapped directly)
   double propagateMs = 0.0;  ///< the propagation kernel, all steps that ran
@@ -36,56 +41,115 @@ struct GpuPropagationTimings {
   double propagateMsPerStep() const { return steps > 0 ? propagateMs / steps : 0.0; }
 };
 
-/// Runs propagation steps on the device. The light field lives there as 3 vec4 per cell
-/// (one per channel: c0, c1x, c1y, c1z; x fastest), converted from and to ShGrid's
-/// planes on upload and readback; step factors as (dc.rgb, active), (linear.rgb, 0).
-/// A step is one fused kernel (normalize sources, gather, apply factors) plus a tiny
+/// Runs propagation steps on the device. A light field there is 3 vec4 per cell (one per
+/// channel: c0, c1x, c1y, c1z), x-fastest where other passes share it and tiled
+/// (SSLPV_TILED_INDEX) in the propagator's own grids; step factors are (dc.rgb, active),
+/// (linear.rgb, 0). From StepFactors::active the host lists work items: tiles of 8 x
+/// tileRows cells marching through runs of slices holding active cells. Only those are
+/// dispatched, so cost follows the occupied cells; every cell outside them holds no light
+/// (injection only fills active cells) and stays zero. A step is one fused kernel
+/// (normalize sources, gather, apply factors, accumulate every other step) plus a tiny
 /// reduction of the per-step power sums that also decides auto steps, so a whole
-/// submission of steps runs without the host. The accumulated grid is updated every
-/// other step with two steps' light at once (it is the largest buffer traffic).
+/// submission of steps runs without the host.
 class GpuPropagator {
  public:
   /// Allocates the grids of `frame` on `device` (which must outlive the propagator) and
   /// uploads `factors` (computeStepFactors() of the material on that frame). Throws
-  /// ResourceError when a grid exceeds the device's storage-buffer range.
+  /// ResourceError when a grid exceeds the device's buffer limits, GpuError when the
+  /// device lacks the subgroup operations the kernel needs.
   GpuPropagator(const VulkanDevice& device, const GridFrame& frame, const StepFactors& factors,
                 const GpuPropagatorOptions& options = {});
 
-  /// Replaces the step factors (the material changed; same frame).
+  /// Replaces the step factors (the material changed; same frame) and the work items.
   void setFactors(const StepFactors& factors);
 
   /// Same contract as sslpv::propagate(): `field` holds the injected light and receives
   /// the last step's light; every step, including the injected one, is added into
-  /// `accumulated`. Both must be on the propagator's frame.
+  /// `accumulated`. Both must be on the propagator's frame. Light in inactive cells is
+  /// not propagated (injection never puts any there).
   PropagationResult run(ShGrid& field, ShGrid& accumulated, const PropagationOptions& options);
+
+  // --- Device-resident use: injection writes sourceField(), shading reads accumulated().
+  // Both are x-fastest grids (layout above); the propagator copies the injected light
+  // into its private tiled grids in one pass and writes the accumulated light back in one
+  // pass, so every step reads sequential memory.
+
+  /// The step-0 source: GPU injection writes the injected light here, only into active
+  /// cells. Propagation only reads it.
+  const Buffer& sourceField() const { return linearSource_; }
+  /// The accumulated light of the last device-resident run: the injected light plus every
+  /// step, zero outside the medium.
+  const Buffer& accumulated() const { return linearAccumulated_; }
+  /// Propagates from sourceField() into accumulated() (overwritten, not added to),
+  /// submitting batches of steps and reading back only the small control and power
+  /// records. initialPower and energy come from the GPU's float sums (initialPower stays
+  /// 0 when no step runs).
+  PropagationResult runOnDevice(const PropagationOptions& options);
+  /// Records the same work into `cmd` without submitting, for a frame's command buffer:
+  /// barriers against earlier compute and transfer writes, and before any later read of
+  /// accumulated(). Auto steps record options.maxAutoSteps steps, which are no-ops after
+  /// the GPU decides to stop; stepsRun() tells how many ran once `cmd` has executed.
+  /// No energy or timings are recorded.
+  void record(VkCommandBuffer cmd, const PropagationOptions& options);
+  /// Steps the last run executed, read from the device (valid once it has finished).
+  int stepsRun() const;
+
+  /// Writes a host grid into sourceField() or accumulated(); `activeOnly` zeroes cells
+  /// that are not active, as injection leaves them.
+  void uploadField(const ShGrid& grid, const Buffer& target, bool activeOnly = false);
+  /// Reads sourceField() or accumulated() into a host grid on the propagator's frame.
+  void downloadField(const Buffer& source, ShGrid& grid);
+  /// Reads the last step's light of the last run (after it has finished).
+  void downloadLastField(ShGrid& grid);
 
   const GpuPropagationTimings& timings() const { return timings_; }
   const GridFrame& frame() const { return frame_; }
-  int groupX() const { return options_.groupX; }
-  int groupY() const { return options_.groupY; }
+  int tileRows() const { return options_.tileRows; }
   int zChunk() const { return zChunk_; }
+  /// Work items per step, the cells they cover (the work a step does), the active cells.
+  std::size_t itemCount() const { return itemCount_; }
+  std::size_t coveredCells() const { return coveredCells_; }
+  std::size_t activeCells() const { return activeCells_; }
 
  private:
-  void upload(const ShGrid& grid, const Buffer& target);
-  void download(const Buffer& source, ShGrid& grid);
+  enum class Mode { Host, Device };
+  using BufferView = DeviceObject<VkBufferView, vkDestroyBufferView>;
+
+  void buildItems(const StepFactors& factors);
+  void writeDescriptors();
+  std::size_t tiledIndex(int x, int y, int z) const;
+  /// Copies between a host grid and a device grid in either layout (through staging
+  /// where device memory is not mappable).
+  void transfer(const ShGrid* from, ShGrid* to, const Buffer& device, bool tiled, bool activeOnly);
   LpvStepPush stepPush(const PropagationOptions& options) const;
-  void recordSteps(VkCommandBuffer cmd, int firstStep, int count, const PropagationOptions& options);
-  void accumulateLastStep(int stepsRun);
+  void recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, int count, const PropagationOptions& options,
+                   bool timestamps);
+  void recordFinish(VkCommandBuffer cmd, Mode mode, int stepLimit, const PropagationOptions& options);
+  void prepareDeviceRun(VkCommandBuffer cmd);
+  PropagationResult execute(Mode mode, const PropagationOptions& options);
 
   const VulkanDevice& device_;
   GridFrame frame_;
   GpuPropagatorOptions options_;
-  int zChunk_ = 0;
-  std::uint32_t groups_[3] = {1, 1, 1};
-  std::uint32_t partialRows_ = 0;
+  int zChunk_ = 0, tilesX_ = 0, tilesY_ = 0;
+  std::size_t itemCount_ = 0, coveredCells_ = 0, activeCells_ = 0;
+  std::vector<LpvItem> items_;
+  std::vector<unsigned char> active_;  ///< for uploads that keep only active cells
   bool staging_ = false;
+  bool tiledAccumulatedClean_ = false;   ///< zero outside the work items
+  bool linearAccumulatedClean_ = false;  ///< zero outside the work items
 
   DescriptorSetLayout setLayout_;
-  ComputePipeline propagatePipeline_, reducePipeline_, accumulatePipeline_;
-  Buffer fields_[2];  ///< ping-pong: step k reads fields_[k % 2]
-  Buffer accumulated_, factors_, partials_, control_, stepTotals_;
-  Buffer stagingBuffer_;    ///< host copy of one field-sized buffer when not mapped
-  StorageBufferSets sets_;  ///< set k % 2 reads fields_[k % 2] and writes the other
+  DescriptorPool pool_;
+  VkDescriptorSet sets_[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};  ///< set k reads tiled_[k]
+  ComputePipeline propagatePipelines_[2];   ///< without and with accumulation
+  ComputePipeline finishPipelines_[2];      ///< into tiled_ / linear accumulated light
+  ComputePipeline reducePipeline_, importPipeline_;
+  Buffer linearSource_, linearAccumulated_;  ///< x-fastest, shared with injection and shading
+  Buffer tiled_[2];                          ///< ping-pong: step k reads tiled_[k % 2]
+  Buffer tiledAccumulated_, factors_, itemBuffer_, partials_, control_, stepTotals_;
+  BufferView tiledViews_[2], tiledAccumulatedView_, factorsView_, linearSourceView_;
+  Buffer stagingBuffer_;  ///< host copy of one field-sized buffer when not mapped
   CommandContext commands_;
   TimestampQueries timestamps_;
   GpuPropagationTimings timings_;

@@ -1,19 +1,41 @@
 #version 460
-// Adds the last step's light to the accumulated grid when that step did not: the
-// propagation kernels accumulate two steps at a time (every other step).
+// Ends a run of propagation steps, over the same work items. The propagation kernel
+// accumulates two steps at a time (every other step), so the last step may still be
+// missing from the accumulated light: it is added here when the GPU's step count says so
+// (auto steps need no host round trip). OUTPUT = 1 (device-resident runs) also writes the
+// total into the x-fastest grid that shading reads.
 #extension GL_GOOGLE_include_directive : require
-
-layout(local_size_x = 64) in;
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "shaders/lpv_step_common.glsl"
 
+layout(local_size_x = SSLPV_TILE_X) in;
+layout(constant_id = 1) const int OUTPUT = 0;
+
 void main() {
   dims = ivec3(push.dimsX, push.dimsY, push.dimsZ);
-  const uint index = gl_GlobalInvocationID.x;
-  const uint cellCount = uint(dims.x * dims.y * dims.z);
-  if (index >= cellCount) return;
-  const ivec3 cell = ivec3(int(index) % dims.x, (int(index) / dims.x) % dims.y, int(index) / (dims.x * dims.y));
-  // Only interior cells change during propagation (inactive ones hold zero).
-  if (!interior(cell)) return;
-  for (int ch = 0; ch < 3; ++ch) accumulated[3 * index + ch] += source[3 * index + ch];
+  const uvec4 item = items[gl_WorkGroupID.x];
+  const int x = int(item.x + gl_SubgroupInvocationID);
+  const int stepsRun = control.stepsRun;
+  // Recorded after every submission of steps: only the end of the run counts.
+  const bool finished = control.stopped != 0 || stepsRun == push.stepLimit;
+  const bool addLast = stepsRun > 0 && stepsRun % 2 == push.leftoverParity;
+  const float last = addLast ? 1.0 : 0.0;
+  const int runs = finished && (OUTPUT == 1 || addLast) ? 1 : 0;
+  for (int once = 0; once < runs; ++once)  // a loop, not an if: lavapipe never skips an if
+    for (int z = int(item.z); z < int(item.w); ++z)
+      [[unroll]] for (int r = 0; r < ROWS; ++r) {
+        const int y = int(item.y) + r;
+        if (x >= dims.x || y >= dims.y) continue;
+        const int i = cellIndex(x, y, z);
+        for (int ch = 0; ch < 3; ++ch) {
+          // The host binds the set whose sourceField holds the last step's light whenever
+          // it is missing (always the same field for a given accumulation parity). Ring
+          // cells hold no light in either grid.
+          const vec4 total = texelFetch(accumulatedIn, 3 * i + ch) + last * texelFetch(sourceField, 3 * i + ch);
+          if (OUTPUT == 1) accumulatedOut[3 * linearIndex(x, y, z) + ch] = total;
+          else accumulated[3 * i + ch] = total;
+        }
+      }
 }

@@ -1,89 +1,184 @@
 #version 460
-// One LPV propagation step (normalize + gather + factors + accumulate, fused), the GPU
-// twin of volume/propagate.cpp. A workgroup owns a TX x TY column of cells and marches
-// it through a chunk of z. Each source cell is loaded and normalized once per column;
-// its x/y neighbours read it from a shared-memory slice with a 1-cell halo, its z
-// neighbours from registers. On lavapipe every buffer or shared access is a loop over
-// the SIMD lanes and both sides of every branch run, so the kernel keeps accesses few
-// and wide (vec4) rather than skipping work with branches.
+// One LPV propagation step (normalize + transfer + factors + accumulate, fused), the GPU
+// twin of volume/propagate.cpp, run only over the occupied part of the grid.
+//
+// A workgroup is one work item: a tile of SSLPV_TILE_X x ROWS cells in x, y marching
+// through a run of slices [zBegin, zEnd) in which the tile holds active cells (the host
+// lists them from StepFactors::active; cells outside every item hold no light and are
+// never read or written, except as zero halos). One invocation owns one x column of the
+// tile. Each source cell is fetched and normalized once per item, and sends its 6 lobes
+// (lpv_transfer.glsl) straight into register accumulators of the cells receiving them:
+// the rows above and below in the same lane, the x neighbours through subgroup shuffles,
+// the slices before and after in the accumulators of 3 slices kept in flight. Only the
+// halo is fetched twice: one row either side, the two x columns packed TILE_X / 2 rows per
+// vector, one slice either end of the run.
+//
+// Why not shared memory: on lavapipe a shared-memory access costs as much as a buffer
+// access (both are loops over the SIMD lanes) while a shuffle is a register permute, and
+// an `if` never skips work (both sides run under a mask) while a loop whose lanes are
+// all inactive does exit: the auto-steps stop is therefore a loop. Nested loops cost
+// (llvmpipe masks every write inside them), so accumulation is a pipeline variant rather
+// than a loop, and the march loads its first two slices in a prologue.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_shuffle : require
+#extension GL_KHR_shader_subgroup_shuffle_relative : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_control_flow_attributes : require
 
-layout(local_size_x_id = 0, local_size_y_id = 1, local_size_z = 1) in;
-
-const uint TX = gl_WorkGroupSize.x;
-const uint TY = gl_WorkGroupSize.y;
-const uint HX = TX + 2;  // slice width with the halo
-
-// One z slice of sources with a 1-cell halo; also the scratch of the final reduction
-// (it has more than TX*TY entries), so that is all the shared memory: 19 KiB at 64x4.
-shared vec4 slice[(TX + 2) * (TY + 2) * 3];
-#define SSLPV_GROUP_SCRATCH slice
 #include "shaders/lpv_step_common.glsl"
+#include "shaders/lpv_transfer.glsl"
 
-/// `local` is in tile coordinates: -1 and TX / TY address the halo.
-void storeSlice(ivec2 local, Source s) {
-  const uint base = 3 * (uint(local.y + 1) * HX + uint(local.x + 1));
-  slice[base] = s.c[0];
-  slice[base + 1] = s.c[1];
-  slice[base + 2] = s.c[2];
+layout(local_size_x = SSLPV_TILE_X) in;
+// ROWS (lpv_step_common.glsl): registers per invocation grow with it.
+/// 1: this step accumulates (push.accumulate 1: accumulated += source + result; 2:
+/// accumulated = source + result, the first step of a device-resident run, which needs
+/// no cleared buffer). 0: it does not.
+layout(constant_id = 1) const int ACCUMULATE = 0;
+
+const int W = SSLPV_TILE_X;
+const int HALF = SSLPV_TILE_X / 2;
+const int HALO_VECTORS = (ROWS + HALF - 1) / HALF;
+
+/// Power sums of one invocation, in the SSLPV_ENERGY_* layout.
+struct StepSums {
+  vec3 emitted, clampRemoved, gathered, absorbed, kept, source;
+};
+
+/// Light arriving in one cell, per channel.
+struct Gathered {
+  vec4 c[3];
+};
+
+/// The lobes of one source cell, per channel. Every cell is normalized, active or not:
+/// cells outside the medium hold no light, and zero light sends nothing. `owned` (0 or 1)
+/// counts the cell's power in `sums`, so that each cell is counted by one invocation.
+struct CellLobes {
+  Lobes ch[3];
+};
+
+CellLobes emitCell(Cell raw, float owned, inout StepSums sums) {
+  CellLobes lobes;
+  vec3 emitted = vec3(0.0), clampRemoved = vec3(0.0);
+  for (int ch = 0; ch < 3; ++ch) lobes.ch[ch] = emitChannel(raw.c[ch], emitted[ch], clampRemoved[ch]);
+  sums.emitted += owned * emitted;
+  sums.clampRemoved += owned * clampRemoved;
+  sums.source += owned * vec3(raw.c[0].x, raw.c[1].x, raw.c[2].x);
+  return lobes;
 }
 
-vec4 sliceAt(ivec2 local, int ch) { return slice[3 * (uint(local.y + 1) * HX + uint(local.x + 1)) + ch]; }
+/// Halo vector h of slice z: lane l < HALF holds the cell left of the tile in row
+/// h * HALF + l, lane l >= HALF the cell right of it in row h * HALF + l - HALF.
+Cell fetchHalo(ivec2 origin, int lane, int h, int z) {
+  const int row = h * HALF + lane % HALF;
+  const int x = lane < HALF ? origin.x - 1 : origin.x + W;
+  return fetchSource(x, row < ROWS ? origin.y + row : -1, z);  // rows past the tile: zero
+}
+
+/// Applies the step factors to the light gathered into cell (x, y, z), writes it, and
+/// every other step adds it to the accumulated light together with the cell's source as
+/// stored (the previous step's light; fetched again, which measured faster than keeping
+/// it in registers), so that accumulating every other step covers every step. Inactive
+/// cells get 0.
+void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
+  if (!interiorXY(x, y)) return;  // also outside the grid; the ring never holds light
+  const int i = cellIndex(x, y, z);
+  const vec4 dc = texelFetch(factors, 2 * i);
+  const vec4 linear = texelFetch(factors, 2 * i + 1);
+  const float on = dc.w;
+  vec4 value[3];
+  for (int ch = 0; ch < 3; ++ch) {
+    value[ch] = on * gathered.c[ch] * vec4(dc[ch], linear[ch], linear[ch], linear[ch]);
+    destination[3 * i + ch] = value[ch];
+    sums.gathered[ch] += on * gathered.c[ch].x;
+    sums.absorbed[ch] += on * gathered.c[ch].x * (1.0 - dc[ch]);
+    sums.kept[ch] += value[ch].x;
+  }
+  if (ACCUMULATE != 0) {
+    // Overwriting multiplies the old value by 0: the buffer is cleared once at setup, so
+    // it never holds a NaN.
+    const float keep = push.accumulate == 1 ? 1.0 : 0.0;
+    for (int ch = 0; ch < 3; ++ch)
+      accumulated[3 * i + ch] = keep * texelFetch(accumulatedIn, 3 * i + ch) + texelFetch(sourceField, 3 * i + ch) + value[ch];
+  }
+}
+
+Gathered nothing() { return Gathered(vec4[3](vec4(0.0), vec4(0.0), vec4(0.0))); }
 
 void main() {
-  // Auto steps stopped in an earlier step of this batch: leave the buffers alone.
-  if (control.stopped != 0) return;
   dims = ivec3(push.dimsX, push.dimsY, push.dimsZ);
-  const ivec2 local = ivec2(gl_LocalInvocationID.xy);
-  const ivec2 groupOrigin = ivec2(gl_WorkGroupID.xy * uvec2(TX, TY));
-  const ivec2 own = groupOrigin + local;
-  const int z0 = int(gl_WorkGroupID.z) * push.zChunk;
-  const int z1 = min(z0 + push.zChunk, dims.z);
+  const uvec4 item = items[gl_WorkGroupID.x];
+  const ivec2 origin = ivec2(item.xy);
+  const int z0 = int(item.z), z1 = int(item.w);
+  const int lane = int(gl_SubgroupInvocationID);
+  const int x = origin.x + lane;
+  StepSums sums = StepSums(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
 
-  // The first 2*(TX+TY) invocations each load one halo cell of every slice (no corners:
-  // the gather has no diagonal neighbours).
-  const uint li = gl_LocalInvocationIndex;
-  const bool loadsHalo = li < 2 * (TX + TY);
-  ivec2 halo;  // tile coordinates of this invocation's halo cell
-  if (li < TX) halo = ivec2(li, -1);
-  else if (li < 2 * TX) halo = ivec2(li - TX, TY);
-  else if (li < 2 * TX + TY) halo = ivec2(-1, li - 2 * TX);
-  else halo = ivec2(TX, li - 2 * TX - TY);
-
-  StepSums sums = noSums();
-  vec4 ownDc, nextDc;
-  Source below = loadHaloEmission(ivec3(own, z0 - 1));
-  Source centerRaw = loadRaw(ivec3(own, z0), ownDc);
-  Source center = emission(centerRaw, ownDc, true, sums);
-  storeSlice(local, center);
-  if (loadsHalo) storeSlice(halo, loadHaloEmission(ivec3(groupOrigin + halo, z0)));
-  barrier();
-
-  for (int z = z0; z < z1; ++z) {
-    const Source aboveRaw = loadRaw(ivec3(own, z + 1), nextDc);
-    const Source above = emission(aboveRaw, nextDc, z + 1 < z1, sums);
-    const ivec3 cell = ivec3(own, z);
-    if (interior(cell)) {
-      const uint index = cellIndex(cell);
-      if (ownDc.w != 0.0) {
-        vec4 gathered[3];
-        for (int ch = 0; ch < 3; ++ch)
-          gathered[ch] = gatherChannel(sliceAt(local + ivec2(1, 0), ch), sliceAt(local - ivec2(1, 0), ch),
-                                       sliceAt(local + ivec2(0, 1), ch), sliceAt(local - ivec2(0, 1), ch),
-                                       above.c[ch], below.c[ch]);
-        storeCell(index, ownDc, gathered, centerRaw, sums);
-      } else {
-        storeInactive(index);
+  // Runs once unless auto steps stopped in an earlier step of current submission.
+  for (int stopped = control.stopped; stopped == 0; stopped = 1) {
+    // Light gathered so far into the tile's rows of slices z (current), z + 1 and z + 2.
+    Gathered current[ROWS], next[ROWS], later[ROWS];
+    [[unroll]] for (int r = 0; r < ROWS; ++r) current[r] = next[r] = later[r] = nothing();
+    // Slice z0 - 1 only matters for the light it sends up into slice z0.
+    [[unroll]] for (int r = 0; r < ROWS; ++r) {
+      const CellLobes lobes = emitCell(fetchSource(x, origin.y + r, z0 - 1), 0.0, sums);
+      for (int ch = 0; ch < 3; ++ch) next[r].c[ch] += lobes.ch[ch].toward[PLUS_Z];
+    }
+    // Iteration z loads slice s = z + 1, whose light goes down into z, sideways within s
+    // and up into s + 1; slice z is then complete. The first iteration completes nothing
+    // (slice z0 - 1 is not the item's), which costs less than a second copy of the loop
+    // body as a prologue would in compile time.
+    for (int z = z0 - 1; z < z1; ++z) {
+      const int s = z + 1;
+      const float owns = s < z1 && x < dims.x ? 1.0 : 0.0;
+      // The halo rows send light into the tile's first and last rows.
+      const CellLobes haloBelow = emitCell(fetchSource(x, origin.y - 1, s), 0.0, sums);
+      const CellLobes haloAbove = emitCell(fetchSource(x, origin.y + ROWS, s), 0.0, sums);
+      for (int ch = 0; ch < 3; ++ch) {
+        next[0].c[ch] += haloBelow.ch[ch].toward[PLUS_Y];
+        next[ROWS - 1].c[ch] += haloAbove.ch[ch].toward[MINUS_Y];
+      }
+      // The x halo columns send light into the tile's first and last lanes.
+      [[unroll]] for (int h = 0; h < HALO_VECTORS; ++h) {
+        const CellLobes halo = emitCell(fetchHalo(origin, lane, h, s), 0.0, sums);
+        for (int ch = 0; ch < 3; ++ch) {
+          const vec4 inward = lane < HALF ? halo.ch[ch].toward[PLUS_X] : halo.ch[ch].toward[MINUS_X];
+          [[unroll]] for (int k = 0; k < HALF; ++k) {
+            const int r = h * HALF + k;
+            // Every lane shuffles (a shuffle from an inactive lane is undefined), then picks.
+            const vec4 fromLeft = subgroupShuffle(inward, uint(k));
+            const vec4 fromRight = subgroupShuffle(inward, uint(HALF + k));
+            if (r < ROWS) next[r].c[ch] += lane == 0 ? fromLeft : lane == W - 1 ? fromRight : vec4(0.0);
+          }
+        }
+      }
+      [[unroll]] for (int r = 0; r < ROWS; ++r) {
+        const CellLobes lobes = emitCell(fetchSource(x, origin.y + r, s), r < ROWS ? owns : 0.0, sums);
+        for (int ch = 0; ch < 3; ++ch) {
+          const vec4 fromLeftLane = subgroupShuffleUp(lobes.ch[ch].toward[PLUS_X], 1);
+          const vec4 fromRightLane = subgroupShuffleDown(lobes.ch[ch].toward[MINUS_X], 1);
+          next[r].c[ch] += (lane > 0 ? fromLeftLane : vec4(0.0)) + (lane < W - 1 ? fromRightLane : vec4(0.0));
+          if (r + 1 < ROWS) next[r + 1].c[ch] += lobes.ch[ch].toward[PLUS_Y];
+          if (r > 0) next[r - 1].c[ch] += lobes.ch[ch].toward[MINUS_Y];
+          current[r].c[ch] += lobes.ch[ch].toward[MINUS_Z];
+          later[r].c[ch] += lobes.ch[ch].toward[PLUS_Z];
+        }
+      }
+      if (z >= z0)
+        [[unroll]] for (int r = 0; r < ROWS; ++r) storeCell(x, origin.y + r, z, current[r], sums);
+      [[unroll]] for (int r = 0; r < ROWS; ++r) {
+        current[r] = next[r];
+        next[r] = later[r];
+        later[r] = nothing();
       }
     }
-    barrier();  // everyone is done reading slice z
-    storeSlice(local, above);
-    if (loadsHalo) storeSlice(halo, loadHaloEmission(ivec3(groupOrigin + halo, z + 1)));
-    barrier();
-    below = center;
-    center = above;
-    centerRaw = aboveRaw;
-    ownDc = nextDc;
+
+    const vec4 row[SSLPV_ENERGY_VEC4S] = vec4[SSLPV_ENERGY_VEC4S](
+        vec4(sums.emitted, sums.clampRemoved.x), vec4(sums.clampRemoved.yz, sums.gathered.xy),
+        vec4(sums.gathered.z, sums.absorbed), vec4(sums.kept, sums.source.x), vec4(sums.source.yz, 0.0, 0.0));
+    for (int k = 0; k < SSLPV_ENERGY_VEC4S; ++k) {
+      const vec4 total = subgroupAdd(row[k]);
+      if (subgroupElect()) partials[SSLPV_ENERGY_VEC4S * gl_WorkGroupID.x + k] = total;
+    }
   }
-  storePartials(sums);
 }

@@ -1,9 +1,11 @@
 #version 460
-// Sums the propagation step's workgroup partial power sums into one row of step totals,
+// Sums the propagation step's per-item partial power sums into one row of step totals,
 // counts the step, and applies the --steps auto rule of volume/propagate.cpp: stop once
 // the step added less than `autoTolerance` of the power accumulated so far, in the worst
 // channel. Keeping the decision on the GPU lets many steps go in one submission.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #include "volume/lpv_constants.h"
 #include "shaders/lpv_shared.h"
 
@@ -11,33 +13,39 @@ layout(local_size_x = SSLPV_REDUCE_GROUP) in;
 
 layout(push_constant) uniform PushBlock { SSLPV_LPV_STEP_PUSH_FIELDS(SSLPV_DECLARE_FIELD) } push;
 
-layout(std430, binding = 4) readonly buffer PartialSums { vec4 partials[]; };
-layout(std430, binding = 5) buffer Control { SSLPV_LPV_CONTROL_FIELDS(SSLPV_DECLARE_FIELD) } control;
-layout(std430, binding = 6) writeonly buffer StepTotals { vec4 totals[]; };
+layout(std430, binding = 6) readonly buffer PartialSums { vec4 partials[]; };
+layout(std430, binding = 7) coherent buffer Control { SSLPV_LPV_CONTROL_FIELDS(SSLPV_DECLARE_FIELD) } control;
+layout(std430, binding = 8) writeonly buffer StepTotals { vec4 totals[]; };
 
-shared vec4 reduction[SSLPV_REDUCE_GROUP];
+// One entry per subgroup (at least 1 lane per subgroup; the group is small).
+shared vec4 subgroupTotals[SSLPV_ENERGY_VEC4S][SSLPV_REDUCE_GROUP];
 
 void main() {
-  if (control.stopped != 0) return;
+  const int stopped = control.stopped;
   const uint li = gl_LocalInvocationIndex;
-  vec4 row[4];
-  for (int k = 0; k < 4; ++k) {
-    vec4 sum = vec4(0.0);
-    for (uint g = li; g < uint(push.partialRows); g += SSLPV_REDUCE_GROUP) sum += partials[4 * g + k];
-    reduction[li] = sum;
-    barrier();
-    for (uint s = SSLPV_REDUCE_GROUP / 2; s > 0; s >>= 1) {
-      if (li < s) reduction[li] += reduction[li + s];
-      barrier();
+  // A loop, not an if: lavapipe skips a loop whose lanes are all inactive, never an if.
+  for (int live = stopped; live == 0; live = 1) {
+    for (int k = 0; k < SSLPV_ENERGY_VEC4S; ++k) {
+      vec4 sum = vec4(0.0);
+      for (uint g = li; g < uint(push.itemCount); g += SSLPV_REDUCE_GROUP) sum += partials[SSLPV_ENERGY_VEC4S * g + k];
+      sum = subgroupAdd(sum);
+      if (subgroupElect()) subgroupTotals[k][gl_SubgroupID] = sum;
     }
-    row[k] = reduction[0];
-    barrier();
   }
-  if (li != 0) return;
-  for (int k = 0; k < 4; ++k) totals[4 * push.stepSlot + k] = row[k];
+  barrier();
+  if (stopped != 0 || li != 0) return;
+  vec4 row[SSLPV_ENERGY_VEC4S];
+  for (int k = 0; k < SSLPV_ENERGY_VEC4S; ++k) {
+    row[k] = vec4(0.0);
+    for (uint s = 0; s < gl_NumSubgroups; ++s) row[k] += subgroupTotals[k][s];
+    totals[SSLPV_ENERGY_VEC4S * push.stepSlot + k] = row[k];
+  }
 
-  const vec3 inGrid = row[3].xyz * float(SSLPV_FLUX_PER_C0);  // SSLPV_ENERGY_IN_GRID
+  const vec3 inGrid = row[3].xyz * float(SSLPV_FLUX_PER_C0);                          // SSLPV_ENERGY_IN_GRID
+  const vec3 source = vec3(row[3].w, row[4].xy) * float(SSLPV_FLUX_PER_C0);           // SSLPV_ENERGY_SOURCE
   vec3 accumulatedPower = vec3(control.accumulatedPowerR, control.accumulatedPowerG, control.accumulatedPowerB);
+  // A device-resident run starts from the power of the injected light, as the CPU does.
+  if (push.initPower != 0) accumulatedPower = source;
   accumulatedPower += inGrid;
   control.accumulatedPowerR = accumulatedPower.r;
   control.accumulatedPowerG = accumulatedPower.g;

@@ -19,18 +19,35 @@
 namespace sslpv::gpu {
 #endif
 
-/// Push constants of the propagation step and the per-step reduction.
+/// Cells along x of one propagation tile: one invocation per column of the tile, so a
+/// tile is exactly one workgroup and (where subgroups hold at least this many lanes) one
+/// subgroup, whose x neighbours come from subgroup shuffles instead of memory.
+#define SSLPV_TILE_X 8
+
+/// Index of cell (x, y, z) in the propagator's private grids (ping-pong fields, factors,
+/// accumulated light): tiles of SSLPV_TILE_X x rows cells in raster order, each tile's
+/// slices contiguous. A tile's march then reads one sequential stream, which the CPU's
+/// prefetchers follow (measured on lavapipe: 43 % less time per step than x-fastest rows,
+/// whose 384-byte pieces 3 KiB apart made every fetch wait for memory). The grids that
+/// injection writes and shading reads keep the x-fastest layout.
+#define SSLPV_TILED_INDEX(x, y, z, tilesX, rows, dimsZ)                                              \
+  ((((((y) / (rows)) * (tilesX) + (x) / SSLPV_TILE_X) * (dimsZ) + (z)) * (rows) + (y) % (rows)) *   \
+       SSLPV_TILE_X +                                                                              \
+   (x) % SSLPV_TILE_X)
+
+/// Push constants of the propagation step, the per-step reduction and the accumulation.
 #define SSLPV_LPV_STEP_PUSH_FIELDS(X)                                                       \
   X(int, dimsX)          /* grid cells per axis */                                        \
   X(int, dimsY)                                                                           \
   X(int, dimsZ)                                                                           \
-  X(int, zChunk)         /* cells along z that one workgroup marches through */           \
-  X(int, partialRows)    /* rows of partial power sums the propagation step wrote */     \
+  X(int, itemCount)      /* work items (runs of tile slices), one partial-sum row each */ \
   X(int, stepSlot)       /* row of the step-totals buffer this step writes */              \
   X(int, autoSteps)      /* 1: stop once a step adds < tolerance of accumulated power */  \
   X(float, autoTolerance)                                                                  \
-  X(int, accumulate)     /* 1: add this step's sources and results to the accumulated grid */ \
-  X(SSLPV_UINT, pad0)
+  X(int, initPower)      /* 1: this step's source power starts the accumulated power */   \
+  X(int, accumulate)     /* 0: no; 1: accumulated += source + result; 2: = source + result */ \
+  X(int, leftoverParity) /* the accumulation kernel adds the last field if stepsRun % 2 is this */ \
+  X(int, stepLimit)      /* ... once stepsRun reaches this or auto steps stopped */
 
 struct LpvStepPush {
   SSLPV_LPV_STEP_PUSH_FIELDS(SSLPV_DECLARE_FIELD)
@@ -38,7 +55,8 @@ struct LpvStepPush {
 
 /// std430 record shared by the step kernels: whether propagation has stopped (auto
 /// steps), how many steps ran, and the power accumulated so far (the stopping rule's
-/// denominator, per channel). Written by the reduction, read by both kernels.
+/// denominator, per channel). Written by the reduction, read by every kernel. All zero
+/// is the state before the first step.
 #define SSLPV_LPV_CONTROL_FIELDS(X) \
   X(int, stopped)                   \
   X(int, stepsRun)                  \
@@ -53,26 +71,41 @@ struct LpvControl {
   SSLPV_LPV_CONTROL_FIELDS(SSLPV_DECLARE_FIELD)
 };
 
-/// One row of per-step power sums, per channel, as floats (4 vec4): the workgroup
+/// One row of per-step power sums, per channel, as floats (5 vec4): the work-item
 /// partial sums and the step totals share this layout. EMITTED and CLAMP_REMOVED are
-/// power (W); GATHERED, ABSORBED and IN_GRID are sums of c0, which the host turns into
-/// power with SSLPV_FLUX_PER_C0 (as the CPU does). Indices into a float[16] row:
+/// power (W); GATHERED, ABSORBED, IN_GRID and SOURCE are sums of c0, which the host turns
+/// into power with SSLPV_FLUX_PER_C0 (as the CPU does). Indices into a float[20] row:
 #define SSLPV_ENERGY_EMITTED 0        // 3 floats: power the sources held (after the clamp)
 #define SSLPV_ENERGY_CLAMP_REMOVED 3  // 3 floats: power the unnormalized clamp would add
 #define SSLPV_ENERGY_GATHERED 6       // 3 floats: c0 arriving in active cells
 #define SSLPV_ENERGY_ABSORBED 9       // 3 floats: c0 * (1 - dc) in active cells
 #define SSLPV_ENERGY_IN_GRID 12       // 3 floats: c0 kept after the step
-#define SSLPV_ENERGY_FLOATS 16        // padded to 4 vec4
+#define SSLPV_ENERGY_SOURCE 15        // 3 floats: c0 of the step's sources as stored
+#define SSLPV_ENERGY_FLOATS 20        // padded to 5 vec4
+#define SSLPV_ENERGY_VEC4S 5
+
+/// One work item of the propagation kernels, a uvec4 in the item buffer: the tile's
+/// first cell (x, y), and the slices [zBegin, zEnd) it marches through.
+#define SSLPV_LPV_ITEM_FIELDS(X) \
+  X(SSLPV_UINT, x)               \
+  X(SSLPV_UINT, y)               \
+  X(SSLPV_UINT, zBegin)          \
+  X(SSLPV_UINT, zEnd)
+
+struct LpvItem {
+  SSLPV_LPV_ITEM_FIELDS(SSLPV_DECLARE_FIELD)
+};
 
 /// Threads of the one-workgroup reduction kernel.
-#define SSLPV_REDUCE_GROUP 256
+#define SSLPV_REDUCE_GROUP 64
 
 #ifdef __cplusplus
 }  // namespace sslpv::gpu
-static_assert(sizeof(sslpv::gpu::LpvStepPush) == 10 * 4, "LpvStepPush must be 4-byte scalars only");
-static_assert(offsetof(sslpv::gpu::LpvStepPush, autoTolerance) == 7 * 4, "LpvStepPush field order");
+static_assert(sizeof(sslpv::gpu::LpvStepPush) == 11 * 4, "LpvStepPush must be 4-byte scalars only");
+static_assert(offsetof(sslpv::gpu::LpvStepPush, autoTolerance) == 6 * 4, "LpvStepPush field order");
 static_assert(sizeof(sslpv::gpu::LpvControl) == 8 * 4, "LpvControl must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::LpvControl, accumulatedPowerR) == 2 * 4, "LpvControl field order");
+static_assert(sizeof(sslpv::gpu::LpvItem) == 4 * 4, "LpvItem is one uvec4");
 #endif
 
 #endif

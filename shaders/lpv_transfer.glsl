@@ -1,7 +1,13 @@
-// The L1 SH face-flux transfer of one LPV step, the GLSL twin of volume/propagate.cpp:
-// the renormalized clamp of a source cell and the light it sends through the 5 faces of
-// one neighbour, re-emitted as cosine lobes. One vec4 holds one channel's coefficients
-// (c0, c1x, c1y, c1z).
+// The L1 SH face-flux transfer of one LPV step, the GLSL twin of volume/propagate.cpp: the
+// renormalized clamp of a source cell and the light it sends through the 5 faces of each
+// of its 6 neighbours, re-emitted there as cosine lobes. One vec4 holds one channel's
+// coefficients (c0, c1x, c1y, c1z).
+//
+// The CPU normalizes a source (scale = power / clamped face flux, never negative) and then
+// evaluates the clamped faces again from the scaled coefficients for each neighbour. As
+// max(0, s u) = s max(0, u) for s >= 0, the GPU evaluates the 30 clamped faces once, sums
+// them for the scale, and forms all 6 outgoing lobes from the same values: the same light
+// (up to float rounding) for about half the arithmetic.
 #ifndef SSLPV_LPV_TRANSFER_GLSL
 #define SSLPV_LPV_TRANSFER_GLSL
 
@@ -17,65 +23,54 @@ const float kHalfY1SideNorm = 0.5 * float(SSLPV_SH_Y1) * kSideNorm;
 const float kEmitDC = float(SSLPV_COSINE_LOBE_C0) / float(SSLPV_PI);
 const float kEmitLinear = float(SSLPV_COSINE_LOBE_C1) / float(SSLPV_PI);
 
-/// Sum of Δω_f · max(0, I(ω_f)) over the 30 faces a cell sends light through.
-float clampedFaceFlux(vec4 c) {
+/// Directions of travel, the index of Lobes::toward.
+const int PLUS_X = 0, MINUS_X = 1, PLUS_Y = 2, MINUS_Y = 3, PLUS_Z = 4, MINUS_Z = 5;
+
+/// What one channel of a source cell sends to each neighbour (toward[d] goes to the
+/// neighbour in direction d), in that neighbour's (c0, c1x, c1y, c1z).
+struct Lobes {
+  vec4 toward[6];
+};
+
+/// Normalizes one channel `c` of a source cell (normalizeEmission on the CPU) and returns
+/// the lobes it sends. Adds the power it holds and the excess the clamp would have created.
+Lobes emitChannel(vec4 c, inout float emitted, inout float clampRemoved) {
   const float base = c.x * kY00;
   float total = 0.0;
+  vec4 axisFrame[6];  // (dc, along the axis, along b1, along b2), unscaled
   for (int a = 0; a < 3; ++a) {
     const float ca = c[1 + a];
     const float h1 = kHalfY1SideNorm * c[1 + (a + 1) % 3];
     const float h2 = kHalfY1SideNorm * c[1 + (a + 2) % 3];
-    for (int sd = -1; sd <= 1; sd += 2) {
-      const float along = float(sd) * kY1 * ca;
-      total += kFront * max(0.0, base + along);
-      const float alongSide = along * kSideNorm;
-      total += kSide * (max(0.0, base + alongSide + h1) + max(0.0, base + alongSide - h1) +
-                        max(0.0, base + alongSide + h2) + max(0.0, base + alongSide - h2));
+    for (int k = 0; k < 2; ++k) {
+      const float sd = k == 0 ? -1.0 : 1.0;  // the CPU's order: -e_a, then +e_a
+      const float along = sd * kY1 * ca;
+      const float front = max(0.0, base + along);
+      const float alongSide = base + along * kSideNorm;
+      const float s1p = max(0.0, alongSide + h1), s1m = max(0.0, alongSide - h1);
+      const float s2p = max(0.0, alongSide + h2), s2m = max(0.0, alongSide - h2);
+      const float sides = s1p + s1m + s2p + s2m;
+      total += kFront * front;
+      total += kSide * sides;
+      axisFrame[2 * a + 1 - k] = vec4(kEmitDC * (kFront * front + kSide * sides), sd * (kEmitLinear * kFront) * front,
+                                      (kEmitLinear * kSide) * (s1p - s1m), (kEmitLinear * kSide) * (s2p - s2m));
     }
   }
-  return total;
-}
-
-/// Rescales one channel so its clamped face fluxes add up to exactly the power it holds
-/// (without it the clamp creates energy). Adds the held power and the removed excess.
-vec4 normalizeEmission(vec4 c, inout float emitted, inout float clampRemoved) {
   const float power = c.x * kFluxPerC0;
-  const float raw = power > 0.0 ? clampedFaceFlux(c) : 0.0;
+  const float raw = power > 0.0 ? total : 0.0;
   const float scale = raw > 0.0 ? power / raw : 0.0;
   emitted += max(0.0, power);
   clampRemoved += max(0.0, raw - power);
-  return c * scale;
-}
-
-/// Light a source channel (c0, c along the axis a, along b1, along b2) sends along sd*e_a
-/// into its neighbour, re-emitted there as cosine lobes; returned in the same axis frame
-/// (dc, along a, along b1, along b2), with b1 = (a+1)%3 and b2 = (a+2)%3.
-vec4 faceTransfer(float c0, float ca, float cb1, float cb2, float sd) {
-  const float base = c0 * kY00;
-  const float along = sd * kY1 * ca;
-  const float front = max(0.0, base + along);
-  const float alongSide = base + along * kSideNorm;
-  const float h1 = kHalfY1SideNorm * cb1;
-  const float h2 = kHalfY1SideNorm * cb2;
-  const float s1p = max(0.0, alongSide + h1), s1m = max(0.0, alongSide - h1);
-  const float s2p = max(0.0, alongSide + h2), s2m = max(0.0, alongSide - h2);
-  return vec4(kEmitDC * (kFront * front + kSide * (s1p + s1m + s2p + s2m)),
-              sd * kEmitLinear * kFront * front,
-              kEmitLinear * kSide * (s1p - s1m),
-              kEmitLinear * kSide * (s2p - s2m));
-}
-
-/// Transfer from a source along ±x (axis frame x, y, z).
-vec4 transferX(vec4 s, float sd) { return faceTransfer(s.x, s.y, s.z, s.w, sd); }
-/// Along ±y: b1 = z, b2 = x.
-vec4 transferY(vec4 s, float sd) {
-  const vec4 t = faceTransfer(s.x, s.z, s.w, s.y, sd);
-  return vec4(t.x, t.w, t.y, t.z);
-}
-/// Along ±z: b1 = x, b2 = y.
-vec4 transferZ(vec4 s, float sd) {
-  const vec4 t = faceTransfer(s.x, s.w, s.y, s.z, sd);
-  return vec4(t.x, t.z, t.w, t.y);
+  // Back to (c0, x, y, z): along x, b1 = y and b2 = z; along y, b1 = z and b2 = x; along
+  // z, b1 = x and b2 = y.
+  Lobes lobes;
+  for (int k = 0; k < 2; ++k) {
+    const vec4 tx = axisFrame[k], ty = axisFrame[2 + k], tz = axisFrame[4 + k];
+    lobes.toward[k] = scale * tx;
+    lobes.toward[2 + k] = scale * vec4(ty.x, ty.w, ty.y, ty.z);
+    lobes.toward[4 + k] = scale * vec4(tz.x, tz.z, tz.w, tz.y);
+  }
+  return lobes;
 }
 
 #endif
