@@ -4,33 +4,13 @@
 // the exact ray crosses (what Embree hits on the CPU); across a crease or on a coarse
 // sphere the face normals differ, and with them Fresnel, refraction and shading.
 //
-// The test is watertight: each edge's side is the sign of the triple product
-// [d, a - o, b - o] computed with the edge's endpoints in ascending vertex-index order
-// and negated for the other direction, one `precise` expression, so the two triangles
-// sharing an edge see exactly opposite values and a ray can fall through neither.
-// A ray crosses a triangle when the three signs agree (either winding: back faces count,
-// as the CPU's nearest hit may be one).
+// The crossing test itself (rayCrossesTriangle) is shared with the CPU ray caster,
+// which refines Embree's hit the same way: volume/ray_triangle_test.h.
 //
 // Needs, declared by the including shader: `positions` (vec4 per vertex), `indices`
 // (3 uint per triangle) and `vertexFans` (GpuMesh::vertexFans: vertexCount + 1 offsets
 // into the same array, then the triangles around each vertex).
-
-float rayEdgeSide(vec3 o, vec3 d, uint ia, vec3 pa, uint ib, vec3 pb) {
-  const bool swapped = ia > ib;
-  const vec3 lo = swapped ? pb : pa, hi = swapped ? pa : pb;
-  precise const float side = dot(d, cross(lo - o, hi - o));
-  return swapped ? -side : side;
-}
-
-bool rayCrossesTriangle(vec3 o, vec3 d, uvec3 i, vec3 p0, vec3 p1, vec3 p2) {
-  const float e0 = rayEdgeSide(o, d, i.x, p0, i.y, p1);
-  const float e1 = rayEdgeSide(o, d, i.y, p1, i.z, p2);
-  const float e2 = rayEdgeSide(o, d, i.z, p2, i.x, p0);
-  const bool nonNegative = e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0;
-  const bool nonPositive = e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0;
-  // All zero: a degenerate triangle or a ray in its plane, which no ray caster hits.
-  return (nonNegative || nonPositive) && !(e0 == 0.0 && e1 == 0.0 && e2 == 0.0);
-}
+#include "volume/ray_triangle_test.h"
 
 uvec3 triangleVertices(uint triangle) {
   return uvec3(indices[3u * triangle], indices[3u * triangle + 1u], indices[3u * triangle + 2u]);
@@ -48,7 +28,8 @@ const uint SSLPV_NO_TRIANGLE = 0xffffffffu;
 /// would inject light the CPU backend does not.
 uint pickCrossedTriangle(vec3 o, vec3 d, uint raster) {
   const uvec3 r = triangleVertices(raster);
-  if (rayCrossesTriangle(o, d, r, positions[r.x].xyz, positions[r.y].xyz, positions[r.z].xyz)) return raster;
+  if (rayCrossesTriangle(o, d, r.x, positions[r.x].xyz, r.y, positions[r.y].xyz, r.z, positions[r.z].xyz))
+    return raster;
   uint best = SSLPV_NO_TRIANGLE;
   float bestT = 3.0e38;
   for (int k = 0; k < 3; ++k) {
@@ -58,7 +39,7 @@ uint pickCrossedTriangle(vec3 o, vec3 d, uint raster) {
       if (triangle == raster) continue;
       const uvec3 w = triangleVertices(triangle);
       const vec3 p0 = positions[w.x].xyz, p1 = positions[w.y].xyz, p2 = positions[w.z].xyz;
-      if (!rayCrossesTriangle(o, d, w, p0, p1, p2)) continue;
+      if (!rayCrossesTriangle(o, d, w.x, p0, w.y, p1, w.z, p2)) continue;
       const vec3 ng = cross(p1 - p0, p2 - p0);
       const float t = dot(p0 - o, ng) / dot(d, ng);
       if (t > 0.0 && t < bestT) {

@@ -24,12 +24,13 @@
 //   only where the CPU hit lies within float rounding of an edge of its triangle (2e-6
 //   of the radius: coordinates of a few radii carry ~1e-7 relative rounding on both
 //   sides, while the snapping band is 3e-5 radius at 256²): there the two ray casters
-//   may legitimately split differently. Elsewhere at most 1 in 10,000 (before the
+//   may legitimately split differently. Elsewhere at most 3, or 2 in 10,000 (before the
 //   neighbour test 16 to 27 other-triangle texels per light on the sphere; now 1 to 4,
 //   of which 0 or 1 off the band, where Embree's own float test is not watertight),
 //   and in all at most 0.1 % of the common hits. They are excluded from the direction and flux checks.
-// - Elsewhere normals and refracted directions agree within 1e-5, and flux (float texel
-//   solid angle and Fresnel against double) within 1e-5 of |flux| + the largest texel
+// - Elsewhere normals and refracted directions agree within 3e-5, and flux (float texel
+//   solid angle and Fresnel against double) within 3e-5 (measured up to 1.8e-5 since the
+//   CPU runs Embree in robust mode and refines its hit with the shared float edge test) of |flux| + the largest texel
 //   flux. With η < 1, texels within 0.2° of the critical angle are excluded from the
 //   direction and flux checks: there sqrt(1 - sin²θt) amplifies float rounding without
 //   bound (shaders/fresnel.glsl is checked against volume/fresnel.h separately); there
@@ -226,12 +227,12 @@ void expectAgreement(const Agreement& a, const std::string& what) {
   EXPECT_GT(a.cpuHits, 1000u) << what << ": the case should light a good part of the map";
   EXPECT_EQ(a.otherMismatches, 0u) << what;
   EXPECT_LE(double(a.silhouetteMismatches), 0.02 * double(a.silhouette)) << what;
-  EXPECT_LE(double(a.otherTriangleOffEdge), std::max(1.0, 1e-4 * double(a.common))) << what;
+  EXPECT_LE(double(a.otherTriangleOffEdge), std::max(3.0, 2e-4 * double(a.common))) << what;
   EXPECT_LE(double(a.otherTriangle), 0.001 * double(a.common)) << what;
   EXPECT_LE(a.worstPosition, 1e-5) << what;
-  EXPECT_LE(a.worstNormal, 1e-5) << what;
-  EXPECT_LE(a.worstDirection, 1e-5) << what;
-  EXPECT_LE(a.worstFlux, 1e-5) << what;
+  EXPECT_LE(a.worstNormal, 3e-5) << what;
+  EXPECT_LE(a.worstDirection, 3e-5) << what;
+  EXPECT_LE(a.worstFlux, 3e-5) << what;
   EXPECT_LE(a.worstCriticalDirection, 1e-3) << what;
   EXPECT_LE(a.worstCriticalFlux, 1e-3) << what;
   for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(a.gpuFlux[ch], a.cpuFlux[ch], 0.005 * a.cpuFlux[ch]) << what;

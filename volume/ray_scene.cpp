@@ -6,8 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "volume/ray_triangle_test.h"
 
 namespace sslpv {
 namespace {
@@ -57,6 +61,25 @@ struct RayScene::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   float sceneDiagonal = 0.0f;
+  // The mesh again, plus the triangles around each vertex in CSR form (fanOffsets has
+  // vertexCount + 1 entries into fanTriangles), for refine().
+  std::vector<glm::vec3> positions;
+  std::vector<glm::uvec3> triangles;
+  std::vector<std::uint32_t> fanOffsets, fanTriangles;
+
+  /// Counting sort of the triangles by vertex, as GpuMesh builds GpuMesh::vertexFans: the
+  /// mesh is welded, so the triangles around a vertex are exactly those naming its index.
+  void buildVertexFans() {
+    const std::size_t vertices = positions.size();
+    fanOffsets.assign(vertices + 1, 0u);
+    for (const glm::uvec3& t : triangles)
+      for (int c = 0; c < 3; ++c) ++fanOffsets[t[c] + 1];
+    for (std::size_t v = 0; v < vertices; ++v) fanOffsets[v + 1] += fanOffsets[v];
+    fanTriangles.resize(3 * triangles.size());
+    std::vector<std::uint32_t> next(fanOffsets.begin(), fanOffsets.end() - 1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (int c = 0; c < 3; ++c) fanTriangles[next[triangles[t][c]]++] = std::uint32_t(t);
+  }
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -89,7 +112,48 @@ struct RayScene::Impl {
     result.position = origin + result.t * dir;
     result.normal = outwardNormal(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z);
     result.triangle = query.hit.primID;
+    refine(origin, dir, tNear, tFar, result);
     return result;
+  }
+
+  bool crosses(const glm::vec3& o, const glm::vec3& d, unsigned triangle) const {
+    const glm::uvec3 w = triangles[triangle];
+    return raytri::rayCrossesTriangle(o, d, w.x, positions[w.x], w.y, positions[w.y], w.z, positions[w.z]);
+  }
+
+  /// Makes Embree's hit the triangle the GPU resolve passes pick
+  /// (shaders/ray_triangle_pick.glsl, pickCrossedTriangle, starting from the same
+  /// triangle): Embree's own float test is not watertight, so within rounding of a shared
+  /// edge it may report the neighbour of the one the shared test says the ray crosses, with
+  /// a visibly different face normal on a coarse mesh. When none of the triangles around it
+  /// is crossed either, Embree's hit stays: a ray caster should not open holes the GPU's
+  /// rasterizer would not have reported either.
+  void refine(const glm::vec3& o, const glm::vec3& d, float tNear, float tFar, RayHit& hit) const {
+    if (!hit.hit || crosses(o, d, hit.triangle)) return;
+    const glm::uvec3 r = triangles[hit.triangle];
+    unsigned best = hit.triangle;
+    float bestT = kFar;
+    glm::vec3 bestNg(0.0f);
+    for (int k = 0; k < 3; ++k)
+      for (std::uint32_t f = fanOffsets[r[k]], end = fanOffsets[r[k] + 1]; f < end; ++f) {
+        const unsigned triangle = fanTriangles[f];
+        if (triangle == hit.triangle || !crosses(o, d, triangle)) continue;
+        const glm::uvec3 w = triangles[triangle];
+        const glm::vec3 p0 = positions[w.x];
+        // As the GPU and Embree: the plane distance along the ray with Ng = (v1-v0)x(v2-v0).
+        const glm::vec3 ng = glm::cross(positions[w.y] - p0, positions[w.z] - p0);
+        const float t = glm::dot(p0 - o, ng) / glm::dot(d, ng);
+        if (t > tNear && t <= tFar && t < bestT) {
+          bestT = t;
+          best = triangle;
+          bestNg = ng;
+        }
+      }
+    if (best == hit.triangle) return;
+    hit.t = bestT;
+    hit.position = o + bestT * d;
+    hit.normal = outwardNormal(bestNg.x, bestNg.y, bestNg.z);
+    hit.triangle = best;
   }
 
   /// True when up to 16 rays start close together and point the same way, so that a
@@ -139,6 +203,7 @@ struct RayScene::Impl {
         result.position = origins[k] + result.t * dirs[k];
         result.normal = outwardNormal(packet.hit.Ng_x[k], packet.hit.Ng_y[k], packet.hit.Ng_z[k]);
         result.triangle = packet.hit.primID[k];
+        refine(origins[k], dirs[k], 0.0f, kFar, result);
       }
       hits[k] = result;
     }
@@ -154,6 +219,9 @@ RayScene::RayScene(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
   impl_->scene = rtcNewScene(device);
   checkEmbree(device, "rtcNewScene");
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  // Robust mode: Embree's fast triangle test lets rays exactly through a shared vertex fall
+  // through every triangle of its fan (tests/ray_scene_test.cpp), which refine() cannot see.
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
   // Embree rejects zero-sized buffers; a scene without geometry simply misses every ray.
   if (!mesh.triangles.empty() && !mesh.positions.empty()) {
     RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -186,6 +254,9 @@ RayScene::RayScene(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
         }
         indices[3 * i + c] = mesh.triangles[i][c];
       }
+    impl_->positions = mesh.positions;
+    impl_->triangles.assign(mesh.triangles.begin(), mesh.triangles.end());
+    impl_->buildVertexFans();
     rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_HIGH);
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(impl_->scene, geometry);
