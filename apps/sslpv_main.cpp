@@ -9,6 +9,11 @@
 #include <string>
 #include <string_view>
 
+#ifdef SSLPV_HAVE_VULKAN
+#include "gpu/device.h"
+#include "gpu/vk_check.h"
+#include "gpu/vulkan_renderer.h"
+#endif
 #include "volume/atomic_file.h"
 #include "volume/cpu_renderer.h"
 #include "volume/error.h"
@@ -30,7 +35,7 @@ int fail(int code, std::string message) {
 }
 
 struct RenderArgs {
-  std::string scene, output, backend = "cpu", steps;
+  std::string scene, output, backend = "vulkan", steps;
   std::optional<int> grid, shadowMap;
   bool timings = false;
   float exposure = 1.0f;
@@ -38,9 +43,8 @@ struct RenderArgs {
 
 int runRender(const RenderArgs& args) {
   using namespace sslpv;
-  if (args.backend == "vulkan")
-    throw InputError("--backend vulkan: the Vulkan backend is not built yet; use --backend cpu");
-  if (args.backend != "cpu") throw InputError("--backend: unknown backend '" + args.backend + "' (cpu, vulkan)");
+  if (args.backend != "cpu" && args.backend != "vulkan")
+    throw InputError("--backend: unknown backend '" + args.backend + "' (vulkan, cpu)");
   if (!isSupportedImageExtension(args.output))
     throw InputError(args.output + ": unsupported output format (use .png, .pfm or .exr)");
   requireWritableOutput(args.output);
@@ -78,9 +82,23 @@ int runRender(const RenderArgs& args) {
   }
   if (!(args.exposure > 0.0f)) throw InputError("--exposure: must be positive");
 
-  CpuRenderer renderer(scene);
   RenderReport report;
-  Image image = renderer.render(settings, &report);
+  Image image;
+  if (args.backend == "cpu") {
+    image = CpuRenderer(scene).render(settings, &report);
+  } else {
+#ifdef SSLPV_HAVE_VULKAN
+    try {
+      gpu::VulkanDevice device;
+      image = gpu::VulkanRenderer(scene, device).render(settings, &report);
+    } catch (const GpuError& e) {
+      // NoVulkanDeviceError included: the machine lacks what the GPU backend needs.
+      throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
+    }
+#else
+    throw ResourceError("--backend vulkan: this sslpv was built without Vulkan (--backend cpu needs no GPU)");
+#endif
+  }
   writeImage(image, args.output, args.exposure);
   if (args.timings) std::cout << formatTimings(report);
   return 0;
@@ -97,7 +115,7 @@ int main(int argc, char** argv) {
   renderCmd->add_option("scene", render.scene, "Scene JSON file")->required();
   renderCmd->add_option("-o,--output", render.output, "Output image (.png tone-mapped, .pfm/.exr linear)")
       ->required();
-  renderCmd->add_option("--backend", render.backend, "cpu (vulkan: not built yet)");
+  renderCmd->add_option("--backend", render.backend, "vulkan (default: Mesa lavapipe or a real GPU) or cpu");
   renderCmd->add_option("--grid", render.grid, "LPV cells along the longest axis (overrides lpv.resolution)");
   renderCmd->add_option("--steps", render.steps, "Propagation steps, or 'auto' (overrides lpv.steps)");
   renderCmd->add_option("--shadow-map", render.shadowMap, "Shadow-map texels per side (overrides lpv.shadow_map)");

@@ -1,0 +1,167 @@
+#include "gpu/vulkan_renderer.h"
+
+#include <chrono>
+
+#include "gpu/gpu_inject.h"
+#include "gpu/gpu_propagation.h"
+#include "gpu/gpu_shade.h"
+#include "gpu/gpu_shadow_map.h"
+#include "gpu/gpu_voxelize.h"
+#include "gpu/graphics.h"
+#include "volume/material_set.h"
+
+namespace sslpv::gpu {
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+VulkanRenderer::VulkanRenderer(const Scene& scene, const VulkanDevice& device)
+    : device_(device), scene_(scene), object_(scene_) {
+  const auto start = std::chrono::steady_clock::now();
+  mesh_ = std::make_unique<GpuMesh>(device_, object_.mesh());
+  voxelizerMesh_ = std::make_unique<VoxelizerMesh>(device_, object_.mesh());
+  injector_ = std::make_unique<GpuInjector>(device_);
+  loadMs_ = object_.loadMs() + msSince(start);
+}
+
+VulkanRenderer::~VulkanRenderer() = default;
+
+void VulkanRenderer::setCamera(const Camera& camera) {
+  scene_.camera = camera;
+  dirty_.cameraChanged();
+}
+
+void VulkanRenderer::setLights(const std::vector<Light>& lights) {
+  scene_.lights = lights;
+  lightsUploaded_ = false;
+  dirty_.lightsChanged();
+}
+
+void VulkanRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) {
+  object_.setMaterialSet(std::move(set));
+  dirty_.materialChanged(touched);
+}
+
+void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& report) {
+  const GridFrame frame = makeGridFrame(object_.bounds(), settings.resolution);
+  const bool sameFrame = voxelizer_ && voxelizer_->frame().dims == frame.dims &&
+                         voxelizer_->frame().origin == frame.origin && voxelizer_->frame().cellSize == frame.cellSize;
+  if (!sameFrame) voxelizer_ = std::make_unique<GpuVoxelizer>(device_, frame);
+  const GpuVoxelizeTimings times = voxelizer_->run(*voxelizerMesh_);
+  report.times.voxelize = times.totalMs();
+  // The occupancy comes back to the host: the step factors and the brick list of the
+  // propagation are built there, together with the resampled material.
+  material_ = MaterialGrid{};
+  material_.frame = frame;
+  material_.coverage = voxelizer_->readCoverage();
+  cellCoverage_ = std::make_unique<Buffer>(uploadCellCoverage(device_, material_));
+  propagator_.reset();
+  report.frame = frame;
+}
+
+void VulkanRenderer::resample(RenderReport& report) {
+  const auto start = std::chrono::steady_clock::now();
+  if (dirty_.resampleRegion() && propagator_) {
+    report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion());
+  } else {
+    resampleMaterial(object_.field(), material_);
+    report.resampledCells = material_.frame.cellCount();
+  }
+  factors_ = computeStepFactors(material_);
+  report.activeCells = 0;
+  for (unsigned char a : factors_.active) report.activeCells += a;
+  if (propagator_) {
+    propagator_->setFactors(factors_);
+    report.times.resample = msSince(start);
+  } else {
+    report.times.resample = msSince(start);
+    // Pipeline creation and shader compilation happen once per grid: setup, not resampling.
+    const auto created = std::chrono::steady_clock::now();
+    propagator_ = std::make_unique<GpuPropagator>(device_, material_.frame, factors_);
+    loadMs_ += msSince(created);
+  }
+}
+
+std::vector<std::uint32_t> VulkanRenderer::readTriangles() const {
+  return shader_ ? shader_->readTriangles() : std::vector<std::uint32_t>{};
+}
+
+Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
+  const auto frameStart = std::chrono::steady_clock::now();
+  if (lastSettings_) dirty_.settingsChanged(*lastSettings_, settings);
+  lastSettings_ = settings;
+  // A new grid invalidates everything that lives on it.
+  if (dirty_.dirty(Stage::Voxelize)) dirty_.everything();
+
+  RenderReport& report = last_;
+  report.backend = "vulkan (" + device_.name() + ")";
+  report.times = StageTimes{};
+  report.triangles = object_.mesh().triangles.size();
+  report.resampledCells = 0;
+
+  if (dirty_.dirty(Stage::Voxelize))
+    rebuildGrid(settings, report);
+  else
+    report.times.markCached(Stage::Voxelize);
+
+  if (dirty_.dirty(Stage::Resample))
+    resample(report);
+  else
+    report.times.markCached(Stage::Resample);
+
+  if (dirty_.dirty(Stage::ShadowMap)) {
+    if (!shadowMapper_ || shadowMapper_->size() != settings.shadowMap) {
+      shadowMapper_ = std::make_unique<GpuShadowMapper>(device_, *mesh_, settings.shadowMap);
+      lightsUploaded_ = false;
+    }
+    if (!lightsUploaded_) {
+      shadowMapper_->setLights(scene_.lights, scene_.material.ior);
+      lightsUploaded_ = true;
+    }
+    report.times.shadowMap = shadowMapper_->run();
+    report.lights = shadowMapper_->stats(shadowMapper_->readSamples());
+  } else {
+    report.times.markCached(Stage::ShadowMap);
+  }
+
+  if (dirty_.dirty(Stage::Injection)) {
+    report.injection = injector_->run(shadowMapper_->samples(), shadowMapper_->sampleCount(), *cellCoverage_,
+                                      material_.frame, propagator_->sourceField());
+    report.times.injection = injector_->lastRunMs();
+  } else {
+    report.times.markCached(Stage::Injection);
+  }
+
+  if (dirty_.dirty(Stage::Propagation)) {
+    PropagationOptions options;
+    options.steps = settings.steps;
+    options.autoSteps = settings.autoSteps;
+    report.propagation = propagator_->runOnDevice(options);
+    const GpuPropagationTimings& t = propagator_->timings();
+    report.times.propagation = t.propagateMs + t.reduceMs;
+  } else {
+    report.times.markCached(Stage::Propagation);
+  }
+
+  if (dirty_.dirty(Stage::Shading)) {
+    if (!shader_ || shader_->width() != scene_.camera.width || shader_->height() != scene_.camera.height)
+      shader_ = std::make_unique<GpuShader>(device_, *mesh_, scene_.camera.width, scene_.camera.height);
+    image_ = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, material_.frame,
+                            scene_.material.ior);
+    report.times.shading = shader_->lastShadeMs();
+  } else {
+    report.times.markCached(Stage::Shading);
+  }
+
+  dirty_.clear();
+  report.times.load = loadMs_;
+  report.wallMs = msSince(frameStart);
+  if (reportOut) *reportOut = report;
+  return image_;
+}
+
+}  // namespace sslpv::gpu

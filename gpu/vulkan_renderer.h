@@ -1,0 +1,79 @@
+#pragma once
+// The Vulkan SSLPV backend: the same frame as CpuRenderer, every per-frame stage on the
+// GPU (voxelization, shadow maps by rasterization, injection, propagation, shading by
+// rasterization), with the same dirty flags so a frame re-runs only what changed.
+// Resampling the painted material set stays on the CPU (OpenVDB) and is uploaded.
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "gpu/device.h"
+#include "volume/frame_report.h"
+#include "volume/image_io.h"
+#include "volume/lpv_stages.h"
+#include "volume/scene.h"
+#include "volume/scene_object.h"
+
+namespace sslpv::gpu {
+
+class GpuMesh;
+class VoxelizerMesh;
+class GpuVoxelizer;
+class GpuShadowMapper;
+class GpuInjector;
+class GpuPropagator;
+class GpuShader;
+class Buffer;
+
+class VulkanRenderer {
+ public:
+  /// Loads the object as the CPU backend does (InputError on bad input) and uploads the
+  /// mesh to `device`, which must outlive the renderer.
+  VulkanRenderer(const Scene& scene, const VulkanDevice& device);
+  ~VulkanRenderer();
+  VulkanRenderer(const VulkanRenderer&) = delete;
+  VulkanRenderer& operator=(const VulkanRenderer&) = delete;
+
+  /// Renders one frame with the given LPV settings, re-running only what changed.
+  /// Stage times in the report are GPU times from timestamps (wall-clock for the CPU
+  /// resampling and where the device has no timestamps).
+  Image render(const LpvSettings& settings, RenderReport* report = nullptr);
+
+  void setCamera(const Camera& camera);
+  void setLights(const std::vector<Light>& lights);
+  void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched);
+
+  const Scene& scene() const { return scene_; }
+  /// Per pixel of the last shaded frame, the 1-based index of the triangle seen there
+  /// (0: background): picking, and comparing with the CPU backend in tests.
+  std::vector<std::uint32_t> readTriangles() const;
+  /// The material grid of the last frame (occupancy from the GPU voxelizer).
+  const MaterialGrid& material() const { return material_; }
+
+ private:
+  void rebuildGrid(const LpvSettings& settings, RenderReport& report);
+  void resample(RenderReport& report);
+
+  const VulkanDevice& device_;
+  Scene scene_;
+  SceneObject object_;
+  double loadMs_ = 0.0;
+  std::unique_ptr<GpuMesh> mesh_;
+  std::unique_ptr<VoxelizerMesh> voxelizerMesh_;
+
+  StageDirty dirty_;
+  bool lightsUploaded_ = false;
+  std::optional<LpvSettings> lastSettings_;
+  MaterialGrid material_;
+  StepFactors factors_;
+  std::unique_ptr<GpuVoxelizer> voxelizer_;
+  std::unique_ptr<Buffer> cellCoverage_;
+  std::unique_ptr<GpuShadowMapper> shadowMapper_;
+  std::unique_ptr<GpuInjector> injector_;
+  std::unique_ptr<GpuPropagator> propagator_;
+  std::unique_ptr<GpuShader> shader_;
+  RenderReport last_;
+  Image image_;
+};
+
+}  // namespace sslpv::gpu
