@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bench/bench_meshes.h"
+#include "bench/device_peaks.h"
 #include "gpu/device.h"
 #include "gpu/vulkan_renderer.h"
 #include "volume/cpu_renderer.h"
@@ -113,12 +114,26 @@ Row measure(Renderer& renderer, const Scene& scene, const Options& o) {
   return row;
 }
 
-void printRow(const Case& c, const char* backend, const Row& r) {
+/// Propagation's achieved rate against the device's roofline (vulkan rows only).
+struct Roofline {
+  bool valid = false;
+  bench::Peaks peaks;
+};
+
+void printRow(const Case& c, const char* backend, const Row& r, const Roofline& roof = {}) {
   const double mcells = r.propagate > 0 ? double(r.activeCells) * r.steps / (r.propagate * 1e3) : 0.0;
-  std::printf("%-9s %-7s %5d %5s %6d %9zu %2d | %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f | %9.2f %9.2f | %8.2f %7d %9zu\n",
+  char roofText[96] = "";
+  if (roof.valid && r.propagate > 0) {
+    const double gflops = mcells * 1e6 * bench::kFlopsPerCellStep * 1e-9;
+    const double gbs = mcells * 1e6 * bench::kBytesPerCellStep * 1e-9;
+    const double intensity = bench::kFlopsPerCellStep / bench::kBytesPerCellStep;
+    const double attainable = std::min(roof.peaks.fmaGflops, intensity * roof.peaks.bandwidth());
+    std::snprintf(roofText, sizeof roofText, " | %7.2f %6.2f %5.1f", gflops, gbs, 100.0 * gflops / attainable);
+  }
+  std::printf("%-9s %-7s %5d %5s %6d %9zu %2d | %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f | %9.2f %9.2f | %8.2f %7d %9zu%s\n",
               c.sweep.c_str(), backend, c.grid, c.steps ? std::to_string(c.steps).c_str() : "auto", c.shadowMap,
               c.triangles, c.lights, r.shadow, r.inject, r.propagate, r.shade, r.total, r.wall, r.cameraOnly,
-              r.voxelize, r.resample, mcells, r.steps, r.activeCells);
+              r.voxelize, r.resample, mcells, r.steps, r.activeCells, roofText);
   std::fflush(stdout);
 }
 
@@ -190,10 +205,20 @@ int main(int argc, char** argv) {
   std::printf("stage columns are device times (GPU timestamps) for vulkan, wall clock per stage for cpu;\n"
               "wall = whole frame as the caller sees it; camera = wall clock of a camera-only re-render;\n"
               "voxelize/resample run once per mesh or material change (shown from the first frame)\n");
-  if (device) std::printf("vulkan device: %s\n", device->name().c_str());
-  std::printf("%-9s %-7s %5s %5s %6s %9s %2s | %8s %8s %8s %8s %8s %8s %8s | %9s %9s | %8s %7s %9s\n", "sweep",
+  Roofline roof;
+  if (device) {
+    std::printf("vulkan device: %s\n", device->name().c_str());
+    bench::PeakProbe probe(*device);
+    roof.peaks = probe.measure(o.repeats);
+    roof.valid = true;
+    std::printf("device peaks measured now: FMA %.1f GFLOP/s, vec4 triad %.2f GB/s; propagation does %.0f flop and\n"
+                "%.0f B per active cell-step (bench/gpu_propagation_bench.cpp explains the count); roof%% = achieved\n"
+                "GFLOP/s over min(FMA peak, flop/B x triad peak)\n",
+                roof.peaks.fmaGflops, roof.peaks.bandwidth(), bench::kFlopsPerCellStep, bench::kBytesPerCellStep);
+  }
+  std::printf("%-9s %-7s %5s %5s %6s %9s %2s | %8s %8s %8s %8s %8s %8s %8s | %9s %9s | %8s %7s %9s | %7s %6s %5s\n", "sweep",
               "backend", "grid", "steps", "shadow", "triangles", "L", "shadow", "inject", "propag", "shade", "total",
-              "wall", "camera", "voxelize", "resample", "Mcell/s", "steps", "active");
+              "wall", "camera", "voxelize", "resample", "Mcell/s", "steps", "active", "GFLOP/s", "GB/s", "roof%");
 
   std::shared_ptr<const TriangleMesh> mesh;
   std::size_t meshTarget = 0;
@@ -212,7 +237,7 @@ int main(int argc, char** argv) {
       }
       if (o.vulkan) {
         gpu::VulkanRenderer vulkan(scene, *device);
-        printRow(shown, "vulkan", measure(vulkan, scene, o));
+        printRow(shown, "vulkan", measure(vulkan, scene, o), roof);
       }
     } catch (const std::exception& e) {
       std::printf("%-9s grid %d: failed: %s\n", c.sweep.c_str(), c.grid, e.what());
