@@ -2,7 +2,11 @@
 // Exit codes: 0 success, 1 internal error, 2 bad input, 3 not enough resources.
 #include <CLI/CLI.hpp>
 
+#include <cctype>
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <new>
 #include <optional>
@@ -19,6 +23,7 @@
 #include "volume/error.h"
 #include "volume/image_io.h"
 #include "volume/material_set.h"
+#include "volume/reference_tracer.h"
 #include "volume/scene.h"
 
 namespace {
@@ -104,6 +109,52 @@ int runRender(const RenderArgs& args) {
   return 0;
 }
 
+struct ReferenceArgs {
+  std::string scene, output;
+  int spp = 0;
+  std::uint64_t seed = 0;
+  int threads = 0;
+};
+
+int runReference(const ReferenceArgs& args) {
+  using namespace sslpv;
+  std::string ext = std::filesystem::path(args.output).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".exr" && ext != ".pfm")
+    throw InputError("-o: " + args.output + ": unsupported output format (use .exr or .pfm: linear radiance)");
+  if (args.spp < 1 || args.spp > 1000000)
+    throw InputError("--spp: must be a whole number from 1 to 1000000, got " + std::to_string(args.spp));
+  if (args.threads < 0 || args.threads > 4096)
+    throw InputError("--threads: must be between 0 (all cores) and 4096, got " + std::to_string(args.threads));
+  std::filesystem::path errorFile(args.output);
+  errorFile.replace_extension(".stderr" + std::filesystem::path(args.output).extension().string());
+  requireWritableOutput(args.output);
+  requireWritableOutput(errorFile);
+
+  const Scene scene = loadScene(args.scene);
+  const ReferenceTracer tracer(scene);
+  ReferenceOptions options;
+  options.spp = args.spp;
+  options.seed = args.seed;
+  options.threads = args.threads;
+  const auto start = std::chrono::steady_clock::now();
+  int lastPercent = -1;
+  options.progress = [&](std::size_t done, std::size_t total) {
+    const int percent = int(100.0 * double(done) / double(total));
+    if (percent == lastPercent) return;
+    lastPercent = percent;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double eta = done > 0 ? elapsed * double(total - done) / double(done) : 0.0;
+    std::fprintf(stderr, "\rreference: %3d%%  %.1f s elapsed, ETA %.1f s   ", percent, elapsed, eta);
+    std::fflush(stderr);
+  };
+  const ReferenceResult result = tracer.render(options);
+  std::fprintf(stderr, "\n");
+  writeImage(result.radiance, args.output);
+  writeImage(result.standardError, errorFile);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -126,10 +177,21 @@ int main(int argc, char** argv) {
   CLI::App* inspectCmd = app.add_subcommand("inspect", "Report the grids of a VDB material set and validate it");
   inspectCmd->add_option("file", inspectFile, "VDB file")->required();
 
+  ReferenceArgs reference;
+  CLI::App* referenceCmd =
+      app.add_subcommand("reference", "Render a ground-truth image with a volumetric path tracer");
+  referenceCmd->add_option("scene", reference.scene, "Scene JSON file")->required();
+  referenceCmd->add_option("-o,--output", reference.output, "Output image (.exr or .pfm, linear radiance)")
+      ->required();
+  referenceCmd->add_option("--spp", reference.spp, "Samples per pixel")->required();
+  referenceCmd->add_option("--seed", reference.seed, "Random seed (same seed, same image)");
+  referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
+
   // CLI11 reports a stray subcommand only as "extra arguments"; name it instead.
   if (argc > 1 && argv[1][0] != '-' && std::string_view(argv[1]) != "render" &&
-      std::string_view(argv[1]) != "inspect")
-    return fail(kExitInput, std::string("unknown subcommand '") + argv[1] + "' (expected render or inspect)");
+      std::string_view(argv[1]) != "inspect" && std::string_view(argv[1]) != "reference")
+    return fail(kExitInput,
+                std::string("unknown subcommand '") + argv[1] + "' (expected render, reference or inspect)");
 
   try {
     app.parse(argc, argv);
@@ -143,6 +205,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*renderCmd) return runRender(render);
+    if (*referenceCmd) return runReference(reference);
     if (*inspectCmd) {
       if (!sslpv::inspectVdbFile(inspectFile, std::cout))
         return fail(kExitInput, inspectFile + ": the material set has validation problems (listed above)");

@@ -1,0 +1,351 @@
+#include "volume/reference_tracer.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+#include <limits>
+#include <mutex>
+
+#include "volume/error.h"
+#include "volume/fresnel.h"
+#include "volume/ray_scene.h"
+#include "volume/scene_object.h"
+
+namespace sslpv {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+/// Surface crossings and scattering events per path before it is cut: only reached by
+/// pathological loops (total internal reflection in an empty region), never by the
+/// estimator in practice; Russian roulette ends ordinary paths long before.
+constexpr int kMaxSegments = 1 << 20;
+/// Scattering events before Russian roulette starts.
+constexpr int kRouletteStart = 8;
+
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+/// Henyey–Greenstein density of the angle between travel directions before and after.
+double hgPhase(double cosTheta, double g) {
+  const double denom = 1.0 + g * g - 2.0 * g * cosTheta;
+  return (1.0 - g * g) / (4.0 * kPi * denom * std::sqrt(denom));
+}
+
+glm::dvec3 sampleHg(const glm::dvec3& d, double g, double u1, double u2) {
+  double cosTheta;
+  if (std::abs(g) < 1e-3) {
+    cosTheta = 1.0 - 2.0 * u1;
+  } else {
+    const double s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u1);
+    cosTheta = (1.0 + g * g - s * s) / (2.0 * g);
+  }
+  cosTheta = std::clamp(cosTheta, -1.0, 1.0);
+  const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
+  const double phi = 2.0 * kPi * u2;
+  // Orthonormal basis around d (Duff et al. 2017).
+  const double sign = std::copysign(1.0, d.z);
+  const double a = -1.0 / (sign + d.z);
+  const double b = d.x * d.y * a;
+  const glm::dvec3 t1(1.0 + sign * d.x * d.x * a, sign * b, -sign * d.x);
+  const glm::dvec3 t2(b, sign + d.y * d.y * a, -d.y);
+  return glm::normalize(sinTheta * std::cos(phi) * t1 + sinTheta * std::sin(phi) * t2 + cosTheta * d);
+}
+
+double channelOf(const glm::vec3& v, int c) { return double(v[c]); }
+
+}  // namespace
+
+ReferenceRng::ReferenceRng(std::uint64_t seed, std::uint64_t stream, std::uint64_t index) {
+  const std::uint64_t key = splitmix(splitmix(seed) ^ splitmix(stream * 0x9e3779b97f4a7c15ull + 1) ^ index);
+  inc_ = (splitmix(key ^ 0xda942042e4dd58b5ull) << 1u) | 1u;
+  state_ = 0;
+  uniform();
+  state_ += key;
+  uniform();
+}
+
+double ReferenceRng::uniform() {
+  // PCG32 (O'Neill 2014): XSH-RR output of a 64-bit LCG.
+  const std::uint64_t old = state_;
+  state_ = old * 6364136223846793005ull + inc_;
+  const auto xorshifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
+  const auto rot = static_cast<std::uint32_t>(old >> 59u);
+  const std::uint32_t out = (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+  return double(out) * (1.0 / 4294967296.0);
+}
+
+struct ReferenceTracer::Impl {
+  Scene scene;
+  std::unique_ptr<SceneObject> object;
+  std::unique_ptr<RayScene> rays;
+  double eta = 1.0;
+  /// Rays leave a surface from the hit point itself and ignore hits closer than this
+  /// (scene units): offsetting the origin instead would skip a sliver of medium, a bias
+  /// of epsilon / thickness in thin slabs.
+  double epsilon = 1e-5;
+
+  struct LightSample {
+    glm::dvec3 toLight{0.0};  ///< unit
+    double distance = 0.0;    ///< infinity for directional lights
+    double value = 0.0;       ///< irradiance on a surface facing the light (before any occlusion)
+  };
+
+  LightSample sampleLight(const Light& light, const glm::dvec3& x, int c) const {
+    LightSample s;
+    if (light.type == Light::Type::Directional) {
+      s.toLight = -glm::normalize(light.direction);
+      s.distance = std::numeric_limits<double>::infinity();
+      s.value = channelOf(light.irradiance, c);
+      return s;
+    }
+    const glm::dvec3 v = light.position - x;
+    s.distance = glm::length(v);
+    if (!(s.distance > 0.0)) return s;
+    s.toLight = v / s.distance;
+    if (light.type == Light::Type::Spot) {
+      // Hard cone of full angle fovDeg around the direction the light travels along.
+      const double cosHalf = std::cos(glm::radians(0.5 * light.fovDeg));
+      if (glm::dot(-s.toLight, glm::normalize(light.direction)) < cosHalf) return s;
+    }
+    s.value = channelOf(light.intensity, c) / (s.distance * s.distance);
+    return s;
+  }
+
+  /// Ratio tracking over the inside parts of origin + t*dir, t in [0, distance]. With
+  /// `fresnel`, each boundary crossing multiplies by the straight-line Fresnel
+  /// transmittance (the approximation stated in the header).
+  double transmittance(const MaterialField::Sampler& field, glm::dvec3 p, const glm::dvec3& dir, double distance,
+                       int c, ReferenceRng& rng, bool fresnel, double sigmaBar) const {
+    double tr = 1.0;
+    double remaining = distance;
+    for (int segment = 0; segment < kMaxSegments && tr > 0.0; ++segment) {
+      const float tFar = std::isfinite(remaining) ? float(remaining) : 3.0e38f;
+      const RayHit hit = rays->intersect(glm::vec3(p), glm::vec3(dir), float(epsilon), tFar);
+      if (!hit.hit) break;  // no more boundary before the end point: outside, nothing attenuates
+      const glm::dvec3 n(hit.normal);
+      const double cosN = glm::dot(dir, n);
+      const double length = double(hit.t);
+      if (cosN > 0.0 && sigmaBar > 0.0) {
+        double t = 0.0;
+        while (true) {
+          t -= std::log(1.0 - rng.uniform()) / sigmaBar;
+          if (t >= length) break;
+          const double sigmaT = channelOf(field.sample(p + t * dir).sigmaT, c);
+          tr *= std::max(0.0, 1.0 - sigmaT / sigmaBar);
+          if (tr < 0.1) {  // Russian roulette keeps the estimator unbiased and the loop short
+            if (rng.uniform() < 0.5) return 0.0;
+            tr *= 2.0;
+          }
+        }
+      }
+      if (fresnel) tr *= 1.0 - fresnelReflectance(std::abs(cosN), eta);
+      p += length * dir;
+      remaining -= length;
+      if (remaining <= 0.0) break;
+    }
+    return tr;
+  }
+
+  double trace(const MaterialField::Sampler& field, glm::dvec3 p, glm::dvec3 d, int c, ReferenceRng& rng,
+               int maxScatterEvents, double sigmaBar) const {
+    double beta = 1.0;
+    double radiance = 0.0;
+    int scatters = 0;
+    for (int segment = 0; segment < kMaxSegments; ++segment) {
+      const RayHit hit = rays->intersect(glm::vec3(p), glm::vec3(d), float(epsilon));
+      if (!hit.hit) return radiance;  // background 0 (or a leak out of the mesh)
+      const glm::dvec3 n(hit.normal);
+      const double cosN = glm::dot(d, n);
+      const double length = double(hit.t);
+      bool scattered = false;
+      if (cosN > 0.0 && sigmaBar > 0.0) {
+        // Inside: delta tracking towards the boundary.
+        double t = 0.0;
+        while (true) {
+          t -= std::log(1.0 - rng.uniform()) / sigmaBar;
+          if (t >= length) break;
+          const glm::dvec3 x = p + t * d;
+          const MaterialSample m = field.sample(x);
+          const double sigmaT = channelOf(m.sigmaT, c);
+          if (rng.uniform() * sigmaBar >= sigmaT) continue;  // null collision
+          beta *= channelOf(m.sigmaS, c) / sigmaT;
+          for (const Light& light : scene.lights) {
+            const LightSample ls = sampleLight(light, x, c);
+            if (ls.value <= 0.0) continue;
+            const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true, sigmaBar);
+            radiance += beta * hgPhase(glm::dot(d, ls.toLight), double(m.g)) * ls.value * tr;
+          }
+          ++scatters;
+          if (maxScatterEvents > 0 && scatters >= maxScatterEvents) return radiance;
+          if (scatters > kRouletteStart) {
+            const double survive = std::min(1.0, beta);
+            if (!(rng.uniform() < survive)) return radiance;
+            beta /= survive;
+          }
+          if (beta <= 0.0) return radiance;
+          const double u1 = rng.uniform();
+          d = sampleHg(d, double(m.g), u1, rng.uniform());
+          p = x;
+          scattered = true;
+          break;
+        }
+      }
+      if (scattered) continue;
+      const glm::dvec3 at = p + length * d;
+      if (cosN > 0.0) {
+        // Leaving the medium. Radiance/n² is invariant across the boundary, so a camera
+        // path crossing outwards gains η² (and loses it again on entering).
+        const double sin2T = eta * eta * (1.0 - cosN * cosN);
+        const double reflect = sin2T >= 1.0 ? 1.0 : fresnelReflectance(std::sqrt(1.0 - sin2T), eta);
+        if (reflect > 0.0 && rng.uniform() < reflect) {
+          d = glm::normalize(d - 2.0 * cosN * n);
+        } else {
+          d = refractInto(d, -n, 1.0 / eta);
+          beta *= eta * eta;
+        }
+      } else {
+        const double reflect = fresnelReflectance(-cosN, eta);
+        if (reflect > 0.0 && rng.uniform() < reflect) {
+          d = glm::normalize(d - 2.0 * cosN * n);
+        } else {
+          d = refractInto(d, n, eta);
+          beta /= eta * eta;
+        }
+      }
+      p = at;
+    }
+    return radiance;
+  }
+};
+
+ReferenceTracer::ReferenceTracer(const Scene& scene)
+    : ReferenceTracer(scene, scene.material.vdb ? loadMaterialSet(*scene.material.vdb) : nullptr) {}
+
+ReferenceTracer::ReferenceTracer(const Scene& scene, std::shared_ptr<const MaterialSet> set)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->scene = scene;
+  // The set is given here, so SceneObject must not load it again.
+  Scene withoutVdb = scene;
+  withoutVdb.material.vdb.reset();
+  impl_->object = std::make_unique<SceneObject>(withoutVdb);
+  glm::dvec3 majorant(scene.material.base.sigmaT);
+  if (set) {
+    const auto fileUnit = unitInMm(set->units);
+    if (!fileUnit)
+      throw InputError((scene.material.vdb ? scene.material.vdb->string() : std::string("material set")) +
+                       ": unknown units '" + set->units + "' in file metadata (expected mm, cm, m or in)");
+    const double sigmaScale = scene.unitInMm / *fileUnit;  // as SceneObject::setMaterialSet
+    // Trilinear weights are convex and inactive voxels read the base, so the field never
+    // exceeds max(active values, base): a global majorant.
+    for (auto it = set->sigmaT->cbeginValueOn(); it; ++it) {
+      const openvdb::Vec3s v = *it;
+      for (int c = 0; c < 3; ++c) majorant[c] = std::max(majorant[c], double(v[c]) * sigmaScale);
+    }
+    impl_->object->setMaterialSet(set);
+  }
+  majorant_ = majorant;
+  impl_->rays = std::make_unique<RayScene>(impl_->object->mesh());
+  impl_->eta = scene.material.ior;
+  const Bounds& b = impl_->object->bounds();
+  const double extent = std::max({b.max.x - b.min.x, b.max.y - b.min.y, b.max.z - b.min.z, 1e-6});
+  // Well above float round-off of Embree's hit distances, well below any feature size.
+  impl_->epsilon = 2e-6 * std::max(extent, glm::length(glm::max(glm::abs(b.min), glm::abs(b.max))));
+}
+
+ReferenceTracer::~ReferenceTracer() = default;
+
+double ReferenceTracer::radianceSample(const glm::dvec3& origin, const glm::dvec3& dir, int channel,
+                                       ReferenceRng& rng, int maxScatterEvents) const {
+  const MaterialField::Sampler field = impl_->object->field().sampler();
+  return impl_->trace(field, origin, dir, channel, rng, maxScatterEvents, majorant_[channel]);
+}
+
+double ReferenceTracer::estimateTransmittance(const glm::dvec3& a, const glm::dvec3& b, int channel,
+                                              ReferenceRng& rng) const {
+  const MaterialField::Sampler field = impl_->object->field().sampler();
+  const double distance = glm::length(b - a);
+  if (!(distance > 0.0)) return 1.0;
+  return impl_->transmittance(field, a, (b - a) / distance, distance, channel, rng, false, majorant_[channel]);
+}
+
+ReferenceResult ReferenceTracer::render(const ReferenceOptions& options) const {
+  if (options.spp < 1) throw InputError("--spp: must be at least 1");
+  const auto start = std::chrono::steady_clock::now();
+  const Camera& camera = impl_->scene.camera;
+  ReferenceResult result;
+  result.radiance = Image(camera.width, camera.height);
+  result.standardError = Image(camera.width, camera.height);
+  // The camera exactly as volume/shade.cpp: pinhole, pixel centres, fov_y, aspect.
+  const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
+  const glm::dvec3 up = glm::cross(right, forward);
+  const double tanHalfY = std::tan(glm::radians(0.5 * camera.fovYDeg));
+  const double tanHalfX = tanHalfY * camera.width / camera.height;
+  const std::size_t total = std::size_t(camera.width) * camera.height;
+  std::atomic<std::size_t> done{0};
+  std::mutex progressMutex;
+  constexpr int kTile = 16;
+
+  auto work = [&] {
+    tbb::parallel_for(
+        tbb::blocked_range2d<int>(0, camera.height, kTile, 0, camera.width, kTile),
+        [&](const tbb::blocked_range2d<int>& tile) {
+          const MaterialField::Sampler field = impl_->object->field().sampler();
+          for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
+            for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
+              const double u = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalfX;
+              const double v = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalfY;
+              const glm::dvec3 dir = glm::normalize(forward + u * right + v * up);
+              const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(camera.width) + std::uint64_t(x);
+              glm::dvec3 sum(0.0), sumSq(0.0);
+              for (int s = 0; s < options.spp; ++s) {
+                ReferenceRng rng(options.seed, pixel, std::uint64_t(s));
+                for (int c = 0; c < 3; ++c) {
+                  const double l = impl_->trace(field, camera.position, dir, c, rng, options.maxScatterEvents,
+                                                majorant_[c]);
+                  sum[c] += l;
+                  sumSq[c] += l * l;
+                }
+              }
+              const double n = options.spp;
+              const glm::dvec3 mean = sum / n;
+              glm::dvec3 se(0.0);
+              if (options.spp > 1) {
+                const glm::dvec3 variance = glm::max(glm::dvec3(0.0), (sumSq - n * mean * mean) / (n - 1.0));
+                se = glm::sqrt(variance / n);
+              }
+              result.radiance.at(x, y) = glm::vec3(mean);
+              result.standardError.at(x, y) = glm::vec3(se);
+            }
+          }
+          const std::size_t now = done.fetch_add(tile.rows().size() * tile.cols().size()) +
+                                  tile.rows().size() * tile.cols().size();
+          if (options.progress) {
+            std::lock_guard<std::mutex> lock(progressMutex);
+            options.progress(now, total);
+          }
+        });
+  };
+  if (options.threads > 0) {
+    tbb::task_arena arena(options.threads);
+    arena.execute(work);
+  } else {
+    work();
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace sslpv

@@ -1,0 +1,93 @@
+#pragma once
+// Ground truth for SSLPV: a Monte Carlo volumetric path tracer over exactly the scene
+// `sslpv render` reads (issue 4). Delta tracking with one global majorant per channel
+// (max σt over the material field), Henyey–Greenstein phase with the local g, RGB traced
+// one channel at a time, a smooth dielectric boundary (ior 1 = invisible boundary) and
+// next-event estimation to point, spot and directional lights.
+//
+// Approximation (ior != 1 only): lights are delta lights outside the object, so a path
+// vertex inside can reach them only through the refracting boundary, and that connection
+// is itself a delta event. The shadow ray therefore goes along the straight line to the
+// light as if the boundary did not bend it, and is weighted by the Fresnel transmittance
+// 1 - F(cos θ) at each crossing, θ being the angle between that line and the surface
+// normal on the outside. Exact when ior == 1. Otherwise the bending of the connection and
+// the solid-angle compression of refraction are ignored, and light that reaches a medium
+// point only after specular reflection(s) at the boundary (internal reflection of the
+// incoming beam) is missed altogether, even at normal incidence. Measured cost: a white
+// furnace (albedo 1, unit sphere, ior 1.4) returns about 75 % of the expected radiance
+// at σt = 0.5, 88 % at σt = 2 and is within its noise of it at σt = 8.
+#include <cstdint>
+#include <functional>
+#include <glm/vec3.hpp>
+#include <memory>
+
+#include "volume/image_io.h"
+#include "volume/material_set.h"
+#include "volume/scene.h"
+
+namespace sslpv {
+
+class SceneObject;
+class RayScene;
+
+/// Counter-based random numbers: one stream per (seed, pixel, sample), so images do not
+/// depend on the thread count or the tile order.
+class ReferenceRng {
+ public:
+  ReferenceRng(std::uint64_t seed, std::uint64_t stream, std::uint64_t index);
+  double uniform();  ///< in [0, 1)
+
+ private:
+  std::uint64_t state_;
+  std::uint64_t inc_;
+};
+
+struct ReferenceOptions {
+  int spp = 16;                 ///< samples per pixel (each traces R, G and B)
+  std::uint64_t seed = 0;
+  int threads = 0;              ///< 0: TBB's default
+  /// Scattering events after which a path ends; 0 = unlimited. 1 gives single
+  /// scattering only (the analytic tests use it).
+  int maxScatterEvents = 0;
+  /// Called with (done pixels, total pixels) from worker threads, serialized.
+  std::function<void(std::size_t, std::size_t)> progress;
+};
+
+struct ReferenceResult {
+  Image radiance;       ///< per-pixel mean radiance, same units as `sslpv render`
+  Image standardError;  ///< per-pixel standard error of that mean
+  double seconds = 0.0;
+};
+
+class ReferenceTracer {
+ public:
+  /// Loads the object (and its material set when the scene names one). InputError on bad input.
+  explicit ReferenceTracer(const Scene& scene);
+  /// Uses `set` (in the scene's material.vdb units; nullptr: base only) instead of loading.
+  ReferenceTracer(const Scene& scene, std::shared_ptr<const MaterialSet> set);
+  ~ReferenceTracer();
+  ReferenceTracer(const ReferenceTracer&) = delete;
+  ReferenceTracer& operator=(const ReferenceTracer&) = delete;
+
+  ReferenceResult render(const ReferenceOptions& options) const;
+
+  /// One estimate of the radiance (channel 0..2) arriving at `origin` from direction
+  /// -`dir` (dir: unit travel direction of the camera ray).
+  double radianceSample(const glm::dvec3& origin, const glm::dvec3& dir, int channel, ReferenceRng& rng,
+                        int maxScatterEvents = 0) const;
+
+  /// One unbiased ratio-tracking estimate of the transmittance of channel `channel`
+  /// along the segment a -> b (only the parts inside the object attenuate; boundaries
+  /// are not counted).
+  double estimateTransmittance(const glm::dvec3& a, const glm::dvec3& b, int channel, ReferenceRng& rng) const;
+
+  /// The per-channel majorant: max σt over the set's active values and the base.
+  glm::dvec3 majorant() const { return majorant_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  glm::dvec3 majorant_{0.0};
+};
+
+}  // namespace sslpv
