@@ -2,13 +2,14 @@
 
 namespace sslpv::gpu {
 
-DescriptorSetLayout makeStorageBufferSetLayout(const VulkanDevice& device, std::uint32_t bindingCount) {
+DescriptorSetLayout makeStorageBufferSetLayout(const VulkanDevice& device, std::uint32_t bindingCount,
+                                               VkShaderStageFlags stages) {
   std::vector<VkDescriptorSetLayoutBinding> bindings(bindingCount);
   for (std::uint32_t i = 0; i < bindingCount; ++i) {
     bindings[i].binding = i;
     bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     bindings[i].descriptorCount = 1;
-    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    bindings[i].stageFlags = stages;
   }
   VkDescriptorSetLayoutCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;

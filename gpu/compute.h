@@ -11,8 +11,10 @@
 
 namespace sslpv::gpu {
 
-/// Layout of `bindingCount` storage buffers at bindings 0..n-1, visible to compute.
-DescriptorSetLayout makeStorageBufferSetLayout(const VulkanDevice& device, std::uint32_t bindingCount);
+/// Layout of `bindingCount` storage buffers at bindings 0..n-1 visible to `stages`; one
+/// layout may serve a graphics and a compute pipeline of the same pass.
+DescriptorSetLayout makeStorageBufferSetLayout(const VulkanDevice& device, std::uint32_t bindingCount,
+                                               VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT);
 
 /// A compute pipeline with its shader module and layout (one descriptor set, optional
 /// push constants). `specialization[i]` is the uint32 value of constant_id i.

@@ -115,24 +115,6 @@ Image2D::Image2D(const VulkanDevice& device, std::uint32_t width, std::uint32_t 
   view_ = ImageViewHandle(vk, view);
 }
 
-DescriptorSetLayout makeStorageBufferSetLayout(const VulkanDevice& device, std::uint32_t bindingCount,
-                                               VkShaderStageFlags stages) {
-  std::vector<VkDescriptorSetLayoutBinding> bindings(bindingCount);
-  for (std::uint32_t i = 0; i < bindingCount; ++i) {
-    bindings[i].binding = i;
-    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[i].descriptorCount = 1;
-    bindings[i].stageFlags = stages;
-  }
-  VkDescriptorSetLayoutCreateInfo info{};
-  info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  info.bindingCount = bindingCount;
-  info.pBindings = bindings.data();
-  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
-  SSLPV_VK_CHECK(vkCreateDescriptorSetLayout(device.handle(), &info, nullptr, &layout));
-  return DescriptorSetLayout(device.handle(), layout);
-}
-
 GraphicsPipeline::GraphicsPipeline(const VulkanDevice& device, const GraphicsPipelineDesc& desc)
     : pushStages_(desc.pushConstantStages) {
   requireDynamicRendering(device);

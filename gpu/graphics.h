@@ -63,12 +63,6 @@ class Image2D {
   VkImageAspectFlags aspect_ = 0;
 };
 
-/// Layout of `bindingCount` storage buffers at bindings 0..n-1 visible to `stages` (the
-/// compute-only variant is in gpu/compute.h). One layout may serve a graphics and a
-/// compute pipeline of the same pass.
-DescriptorSetLayout makeStorageBufferSetLayout(const VulkanDevice& device, std::uint32_t bindingCount,
-                                               VkShaderStageFlags stages);
-
 struct GraphicsPipelineDesc {
   spirv::SpirvCode vertex, fragment;
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;  ///< one set (required)
