@@ -23,7 +23,6 @@ VulkanRenderer::VulkanRenderer(const Scene& scene, const VulkanDevice& device)
     : device_(device), scene_(scene), object_(scene_) {
   const auto start = std::chrono::steady_clock::now();
   mesh_ = std::make_unique<GpuMesh>(device_, object_.mesh());
-  voxelizerMesh_ = std::make_unique<VoxelizerMesh>(device_, object_.mesh());
   injector_ = std::make_unique<GpuInjector>(device_);
   loadMs_ = object_.loadMs() + msSince(start);
 }
@@ -51,7 +50,8 @@ void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& repo
   const bool sameFrame = voxelizer_ && voxelizer_->frame().dims == frame.dims &&
                          voxelizer_->frame().origin == frame.origin && voxelizer_->frame().cellSize == frame.cellSize;
   if (!sameFrame) voxelizer_ = std::make_unique<GpuVoxelizer>(device_, frame);
-  const GpuVoxelizeTimings times = voxelizer_->run(*voxelizerMesh_);
+  // GpuMesh holds the vec4 positions and uint indices the voxelizer reads: one upload.
+  const GpuVoxelizeTimings times = voxelizer_->run(mesh_->positions(), mesh_->indices(), mesh_->triangleCount());
   report.times.voxelize = times.totalMs();
   // The occupancy comes back to the host: the step factors and the brick list of the
   // propagation are built there, together with the resampled material.
@@ -123,7 +123,15 @@ Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOu
       lightsUploaded_ = true;
     }
     report.times.shadowMap = shadowMapper_->run();
-    report.lights = shadowMapper_->stats(shadowMapper_->readSamples());
+    // Texel counts and culling only: hits and flux would need every texel record read
+    // back each frame (4 MB per 256² view); GpuShadowMapper::stats() gives them on demand.
+    report.lights.clear();
+    for (const GpuShadowLight& placed : shadowMapper_->lights()) {
+      ShadowMapStats stats;
+      stats.texels = placed.sampleCount;
+      stats.culled = placed.culled;
+      report.lights.push_back(stats);
+    }
   } else {
     report.times.markCached(Stage::ShadowMap);
   }

@@ -17,7 +17,6 @@
 namespace sslpv::gpu {
 
 class GpuMesh;
-class VoxelizerMesh;
 class GpuVoxelizer;
 class GpuShadowMapper;
 class GpuInjector;
@@ -59,7 +58,6 @@ class VulkanRenderer {
   SceneObject object_;
   double loadMs_ = 0.0;
   std::unique_ptr<GpuMesh> mesh_;
-  std::unique_ptr<VoxelizerMesh> voxelizerMesh_;
 
   StageDirty dirty_;
   bool lightsUploaded_ = false;

@@ -37,6 +37,7 @@ struct RenderReport {
   /// Wall-clock milliseconds of the whole frame as the caller saw it, submissions and
   /// read-backs included (the stage rows of the GPU backend are device times).
   double wallMs = 0.0;
+  /// Per light. The Vulkan backend fills texels and culled only (see VulkanRenderer).
   std::vector<ShadowMapStats> lights;
   InjectionStats injection;
   PropagationResult propagation;
