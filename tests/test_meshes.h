@@ -8,6 +8,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "volume/lpv_grid.h"
 #include "volume/mesh.h"
 
 namespace sslpv::test {
@@ -75,6 +76,37 @@ inline double enclosedVolume(const TriangleMesh& mesh) {
     sixTimes += glm::dot(glm::dvec3(mesh.positions[t.x]),
                          glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z])));
   return sixTimes / 6.0;
+}
+
+/// Coverage of a sphere of `radius` about the origin against s³ point samples per cell:
+/// the worst cell's error and the mean error over boundary cells (0 < expected < 1).
+struct SupersampledSphereError {
+  double worst = 0.0, meanBoundary = 0.0;
+  int boundaryCells = 0;
+};
+
+inline SupersampledSphereError compareWithSupersampledSphere(const std::vector<float>& coverage,
+                                                             const GridFrame& frame, double radius, int s = 12) {
+  SupersampledSphereError result;
+  double sumError = 0.0;
+  for (int z = 0; z < frame.dims.z; ++z)
+    for (int y = 0; y < frame.dims.y; ++y)
+      for (int x = 0; x < frame.dims.x; ++x) {
+        int inside = 0;
+        for (int k = 0; k < s * s * s; ++k) {
+          const glm::dvec3 sub((k % s + 0.5) / s, ((k / s) % s + 0.5) / s, (k / (s * s) + 0.5) / s);
+          if (glm::length(frame.cellMin(x, y, z) + sub * frame.cellSize) < radius) ++inside;
+        }
+        const double expected = double(inside) / (s * s * s);
+        const double error = std::abs(coverage[frame.index(x, y, z)] - expected);
+        result.worst = std::max(result.worst, error);
+        if (expected > 0.0 && expected < 1.0) {
+          sumError += error;
+          ++result.boundaryCells;
+        }
+      }
+  if (result.boundaryCells > 0) result.meanBoundary = sumError / result.boundaryCells;
+  return result;
 }
 
 }  // namespace sslpv::test

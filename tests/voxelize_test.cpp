@@ -127,30 +127,12 @@ TEST(Voxelize, SphereCellsMatchSupersampledCoverage) {
   frame.origin = glm::dvec3(-14.0 * frame.cellSize) + 0.17 * frame.cellSize;
   const std::vector<float> coverage =
       voxelizeCoverage(makeIcosphere(glm::vec3(0.0f), float(radius), 6), frame);
-  double worst = 0.0, sumError = 0.0;
-  int boundaryCells = 0;
-  const int s = 12;
-  for (int z = 0; z < frame.dims.z; ++z)
-    for (int y = 0; y < frame.dims.y; ++y)
-      for (int x = 0; x < frame.dims.x; ++x) {
-        int inside = 0;
-        for (int k = 0; k < s * s * s; ++k) {
-          const glm::dvec3 sub((k % s + 0.5) / s, ((k / s) % s + 0.5) / s, (k / (s * s) + 0.5) / s);
-          if (glm::length(frame.cellMin(x, y, z) + sub * frame.cellSize) < radius) ++inside;
-        }
-        const double expected = double(inside) / (s * s * s);
-        const double error = std::abs(coverage[frame.index(x, y, z)] - expected);
-        worst = std::max(worst, error);
-        if (expected > 0.0 && expected < 1.0) {
-          sumError += error;
-          ++boundaryCells;
-        }
-      }
-  ASSERT_GT(boundaryCells, 1000);
+  const test::SupersampledSphereError e = test::compareWithSupersampledSphere(coverage, frame, radius);
+  ASSERT_GT(e.boundaryCells, 1000);
   // The linear ramp clamp(0.5 - d) would be off by up to ~0.05 on oblique cells; the
   // exact plane-cube fraction leaves only the curvature error, O((h/r)^2) of a cell.
-  EXPECT_LT(worst, 0.03);
-  EXPECT_LT(sumError / boundaryCells, 0.008);
+  EXPECT_LT(e.worst, 0.03);
+  EXPECT_LT(e.meanBoundary, 0.008);
 }
 
 TEST(Voxelize, MeshOutsideFrameGivesAllZeros) {
