@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 #include <iostream>
 #include <new>
 #include <optional>
@@ -187,11 +188,18 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--seed", reference.seed, "Random seed (same seed, same image)");
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
 
+  // Subcommands from apps/cmd_*.cpp (each: Args struct, add<Name>Command, run<Name>).
+
   // CLI11 reports a stray subcommand only as "extra arguments"; name it instead.
-  if (argc > 1 && argv[1][0] != '-' && std::string_view(argv[1]) != "render" &&
-      std::string_view(argv[1]) != "inspect" && std::string_view(argv[1]) != "reference")
-    return fail(kExitInput,
-                std::string("unknown subcommand '") + argv[1] + "' (expected render, reference or inspect)");
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string known;
+    bool found = false;
+    for (const CLI::App* sub : std::as_const(app).get_subcommands([](const CLI::App*) { return true; })) {
+      found = found || sub->get_name() == argv[1];
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!found) return fail(kExitInput, std::string("unknown subcommand '") + argv[1] + "' (expected " + known + ")");
+  }
 
   try {
     app.parse(argc, argv);
@@ -206,6 +214,7 @@ int main(int argc, char** argv) {
   try {
     if (*renderCmd) return runRender(render);
     if (*referenceCmd) return runReference(reference);
+    // Dispatch of the apps/cmd_*.cpp subcommands.
     if (*inspectCmd) {
       if (!sslpv::inspectVdbFile(inspectFile, std::cout))
         return fail(kExitInput, inspectFile + ": the material set has validation problems (listed above)");
