@@ -14,7 +14,7 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 7;  // see the bindings of shaders/shade.{vert,comp}
+constexpr std::uint32_t kBindings = 8;  // see the bindings of shaders/shade.{vert,comp}
 constexpr VkFormat kTriangleFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
@@ -66,6 +66,19 @@ Buffer uploadLightField(const VulkanDevice& device, const ShGrid& grid) {
   return buffer;
 }
 
+Buffer uploadExitGain(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame) {
+  const std::size_t cells = frame.cellCount();
+  for (const std::vector<float>& gain : factors.exitGain)
+    if (gain.size() != cells) throw GpuError("uploadExitGain: the step factors do not match the grid frame");
+  std::vector<float> packed(std::max<std::size_t>(cells, 1) * 4, 0.0f);
+  for (std::size_t i = 0; i < cells; ++i)
+    for (int ch = 0; ch < 3; ++ch) packed[i * 4 + ch] = factors.exitGain[ch][i];
+  Buffer buffer(device, packed.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                MemoryUse::Device);
+  uploadToBuffer(device, buffer, packed.data(), packed.size() * sizeof(float));
+  return buffer;
+}
+
 GpuShader::GpuShader(const VulkanDevice& device, const GpuMesh& mesh, int width, int height)
     : device_(device), mesh_(mesh), width_(width), height_(height), commands_(device) {
   requireDynamicRendering(device);
@@ -102,7 +115,7 @@ GpuShader::GpuShader(const VulkanDevice& device, const GpuMesh& mesh, int width,
 }
 
 void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
-                       const GridFrame& frame, double ior, TimestampQueries* timestamps, std::uint32_t firstQuery) {
+                       const Buffer& exitGain, const GridFrame& frame, double ior, TimestampQueries* timestamps, std::uint32_t firstQuery) {
   if (camera.width != width_ || camera.height != height_)
     throw GpuError("GpuShader: the camera is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
                    ", the shader renders " + std::to_string(width_) + "x" + std::to_string(height_));
@@ -110,12 +123,14 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
   if (frame.cellCount() > std::size_t(0xffffffffu) / 3) throw GpuError("GpuShader: the grid has too many cells");
   requireBytes(accumulated, lightFieldBytes(frame), "accumulated light field");
   requireBytes(cellCoverage, VkDeviceSize(frame.cellCount()) * sizeof(float), "cell coverage");
+  requireBytes(exitGain, VkDeviceSize(frame.cellCount()) * 4 * sizeof(float), "exit gain");
   // Rewritten every recording, hence one recording in flight per shader (see the class).
   sets_.write(0, 0, mesh_.positions());
   sets_.write(0, 1, mesh_.indices());
   sets_.write(0, 2, accumulated);
   sets_.write(0, 3, cellCoverage);
   sets_.write(0, 6, mesh_.vertexFans());
+  sets_.write(0, 7, exitGain);
   const GpuShadePush push = shadePush(camera, mesh_.bounds(), frame, ior);
 
   if (timestamps) timestamps->write(cmd, firstQuery);
@@ -158,10 +173,10 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
 }
 
 Image GpuShader::shade(const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
-                       const GridFrame& frame, double ior) {
+                       const Buffer& exitGain, const GridFrame& frame, double ior) {
   VkCommandBuffer cmd = commands_.begin();
   timestamps_.reset(cmd);
-  record(cmd, camera, accumulated, cellCoverage, frame, ior, &timestamps_, 0);
+  record(cmd, camera, accumulated, cellCoverage, exitGain, frame, ior, &timestamps_, 0);
   commands_.submitAndWait();
   lastShadeMs_ = timestamps_.readMilliseconds(2)[1];
 

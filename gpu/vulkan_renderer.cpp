@@ -63,7 +63,7 @@ void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& repo
   report.frame = frame;
 }
 
-void VulkanRenderer::resample(RenderReport& report) {
+void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report) {
   const auto start = std::chrono::steady_clock::now();
   if (dirty_.resampleRegion() && propagator_) {
     report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion());
@@ -71,7 +71,8 @@ void VulkanRenderer::resample(RenderReport& report) {
     resampleMaterial(object_.field(), material_);
     report.resampledCells = material_.frame.cellCount();
   }
-  factors_ = computeStepFactors(material_);
+  factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
+  exitGain_ = std::make_unique<Buffer>(uploadExitGain(device_, factors_, material_.frame));
   report.activeCells = 0;
   for (unsigned char a : factors_.active) report.activeCells += a;
   if (propagator_) {
@@ -109,7 +110,7 @@ Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOu
     report.times.markCached(Stage::Voxelize);
 
   if (dirty_.dirty(Stage::Resample))
-    resample(report);
+    resample(settings, report);
   else
     report.times.markCached(Stage::Resample);
 
@@ -158,7 +159,7 @@ Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOu
   if (dirty_.dirty(Stage::Shading)) {
     if (!shader_ || shader_->width() != scene_.camera.width || shader_->height() != scene_.camera.height)
       shader_ = std::make_unique<GpuShader>(device_, *mesh_, scene_.camera.width, scene_.camera.height);
-    image_ = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, material_.frame,
+    image_ = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, *exitGain_, material_.frame,
                             scene_.material.ior);
     report.times.shading = shader_->lastShadeMs();
   } else {

@@ -51,7 +51,7 @@ class VulkanRenderer {
 
  private:
   void rebuildGrid(const LpvSettings& settings, RenderReport& report);
-  void resample(RenderReport& report);
+  void resample(const LpvSettings& settings, RenderReport& report);
 
   const VulkanDevice& device_;
   Scene scene_;
@@ -64,6 +64,7 @@ class VulkanRenderer {
   std::optional<LpvSettings> lastSettings_;
   MaterialGrid material_;
   StepFactors factors_;
+  std::unique_ptr<Buffer> exitGain_;  ///< factors_.exitGain on the device, for shading
   std::unique_ptr<GpuVoxelizer> voxelizer_;
   std::unique_ptr<Buffer> cellCoverage_;
   std::unique_ptr<GpuShadowMapper> shadowMapper_;

@@ -5,7 +5,8 @@
 // the pixel's camera ray meets the triangle's plane; the accumulated LPV is read half a
 // cell inside the surface (a full cell when no active cell is near) with the
 // coverage-weighted active trilinear weights of activeTrilinearWeights; radiance
-// L = T(θo)/η² · (1/(Aπ)) ∫_H I(ω) dω per channel. Output: one vec4 per pixel, row 0 at
+// L = T(θo)/η² · (1/(Aπ)) ∫_H G I(ω) dω per channel, G the cell's exit gain.
+// Output: one vec4 per pixel, row 0 at
 // the top, (radiance, 1) on the surface (black where the ray leaves from inside or no
 // active cell is near), (0, 0, 0, 0) for the background.
 #extension GL_GOOGLE_include_directive : require
@@ -27,6 +28,8 @@ layout(std430, set = 0, binding = 2) readonly buffer Field { vec4 field[]; };
 layout(std430, set = 0, binding = 4) buffer Triangles { uint triangles[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Radiance { vec4 radiance[]; };
 layout(std430, set = 0, binding = 6) readonly buffer VertexFans { uint vertexFans[]; };
+// Per cell (r, g, b, 0): StepFactors::exitGain, the calibrated scheme's surface coupling.
+layout(std430, set = 0, binding = 7) readonly buffer ExitGain { vec4 exitGain[]; };
 layout(push_constant) uniform Push { GpuShadePush push; };
 
 #include "shaders/ray_triangle_pick.glsl"
@@ -73,7 +76,7 @@ void main() {
       const float scale = push.viewport.z * (1.0 - fresnelReflectance(cosOut, push.up.w));
       for (int ch = 0; ch < 3; ++ch) {
         vec4 c = vec4(0.0);
-        for (int i = 0; i < used; ++i) c += weights[i] * field[3u * cells[i] + uint(ch)];
+        for (int i = 0; i < used; ++i) c += weights[i] * exitGain[cells[i]][ch] * field[3u * cells[i] + uint(ch)];
         result[ch] = max(0.0, float(SSLPV_HEMI_Y00) * c.x + float(SSLPV_HEMI_Y1) * dot(c.yzw, n)) * scale;
       }
     }

@@ -55,6 +55,7 @@ struct LitObject {
   TriangleMesh mesh;
   MaterialGrid material;
   ShGrid accumulated;
+  StepFactors factors;  ///< calibrated, exit gains varied per cell
 };
 
 LitObject lightObject(TriangleMesh mesh, const std::vector<Light>& lights, double ior, int resolution) {
@@ -79,7 +80,13 @@ LitObject lightObject(TriangleMesh mesh, const std::vector<Light>& lights, doubl
   injectSamples(samples, o.material, field);
   PropagationOptions options;
   options.steps = 24;
-  propagate(o.material, computeStepFactors(o.material), field, o.accumulated, options);
+  o.factors = computeStepFactors(o.material, LpvScheme::Calibrated, ior);
+  propagate(o.material, o.factors, field, o.accumulated, options);
+  // A homogeneous medium has one gain per channel; vary it per cell so a wrong cell or
+  // channel index in the GPU's gain lookup shows.
+  for (int ch = 0; ch < 3; ++ch)
+    for (std::size_t i = 0; i < o.factors.exitGain[ch].size(); ++i)
+      o.factors.exitGain[ch][i] *= float(1.0 + 0.5 * std::sin(0.37 * double(i) + 1.7 * ch));
   return o;
 }
 
@@ -111,12 +118,13 @@ class GpuShadeTest : public GpuTest {
   /// Shades `o` from `camera` with both backends and checks the expectations above.
   void compareWithCpu(const LitObject& o, const Camera& camera, double ior, const std::string& what) {
     RayScene rays(o.mesh);
-    const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, ior);
+    const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, ior, &o.factors.exitGain);
     gpu::GpuMesh mesh(device(), o.mesh);
     gpu::GpuShader shader(device(), mesh, camera.width, camera.height);
     const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
     const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
-    const Image gpuImage = shader.shade(camera, field, coverage, o.material.frame, ior);
+  const gpu::Buffer gain = gpu::uploadExitGain(device(), o.factors, o.material.frame);
+    const Image gpuImage = shader.shade(camera, field, coverage, gain, o.material.frame, ior);
     ASSERT_EQ(gpuImage.width, cpu.width);
     ASSERT_EQ(gpuImage.height, cpu.height);
     const std::vector<std::uint32_t> gpuTriangles = shader.readTriangles(), cpuTri = cpuTriangles(camera, rays);
@@ -182,12 +190,13 @@ TEST_F(GpuShadeTest, FromInsideTheObjectEverythingIsBlackOnBoth) {
       lightObject(makeIcosphere(glm::vec3(0.0f), 1.0f, 4), {pointLight({0, 2, 3}, glm::vec3(5.0f))}, 1.3, 24);
   const Camera camera = cameraAt({0.1, 0.2, 0.3}, {1.0, 0.0, 0.0}, 128, 96, 60.0);
   RayScene rays(o.mesh);
-  const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, 1.3);
+  const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain);
   gpu::GpuMesh mesh(device(), o.mesh);
   gpu::GpuShader shader(device(), mesh, camera.width, camera.height);
   const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
   const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
-  const Image gpuImage = shader.shade(camera, field, coverage, o.material.frame, 1.3);
+  const gpu::Buffer gain = gpu::uploadExitGain(device(), o.factors, o.material.frame);
+  const Image gpuImage = shader.shade(camera, field, coverage, gain, o.material.frame, 1.3);
   const std::vector<std::uint32_t> gpuTriangles = shader.readTriangles(), cpuTri = cpuTriangles(camera, rays);
   std::size_t black = 0, sameTriangle = 0;
   for (std::size_t i = 0; i < cpu.pixels.size(); ++i) {
@@ -217,10 +226,11 @@ TEST_F(GpuShadeTest, ReportsGpuTimeOfA512ImageOfA20KTriangleSphere) {
   gpu::GpuShader shader(device(), mesh, 512, 512);
   const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
   const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
-  shader.shade(camera, field, coverage, o.material.frame, 1.3);
+  const gpu::Buffer gain = gpu::uploadExitGain(device(), o.factors, o.material.frame);
+  shader.shade(camera, field, coverage, gain, o.material.frame, 1.3);
   std::vector<double> ms;
   for (int i = 0; i < 5; ++i) {
-    shader.shade(camera, field, coverage, o.material.frame, 1.3);
+    shader.shade(camera, field, coverage, gain, o.material.frame, 1.3);
     ms.push_back(shader.lastShadeMs());
   }
   std::sort(ms.begin(), ms.end());

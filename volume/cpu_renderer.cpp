@@ -80,7 +80,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
       resampleMaterial(object_.field(), material_);
       report.resampledCells = material_.frame.cellCount();
     }
-    factors_ = computeStepFactors(material_);
+    factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
     report.activeCells = 0;
     for (unsigned char a : factors_.active) report.activeCells += a;
     report.times.resample = watch.lapMs();
@@ -125,7 +125,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
   }
 
   if (dirty_.dirty(Stage::Shading)) {
-    image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior);
+    image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain);
     report.times.shading = watch.lapMs();
   } else {
     report.times.markCached(Stage::Shading);

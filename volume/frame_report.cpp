@@ -27,6 +27,11 @@ void StageDirty::settingsChanged(const LpvSettings& before, const LpvSettings& a
     return;
   }
   if (before.shadowMap != after.shadowMap) lightsChanged();
+  // The step factors are derived with the material, so a new scheme redoes that stage.
+  if (before.scheme != after.scheme) {
+    set({Stage::Resample, Stage::Propagation, Stage::Shading});
+    region_.reset();
+  }
   if (before.steps != after.steps || before.autoSteps != after.autoSteps)
     set({Stage::Propagation, Stage::Shading});
 }

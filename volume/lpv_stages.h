@@ -6,6 +6,7 @@
 #include <glm/vec3.hpp>
 #include <vector>
 
+#include "volume/lpv_calibration.h"
 #include "volume/lpv_grid.h"
 #include "volume/mesh.h"
 #include "volume/scene.h"
@@ -79,17 +80,27 @@ struct PropagationResult {
   std::vector<StepEnergy> energy;  ///< one entry per step when recordEnergy
 };
 
-/// Per-cell transport factors of one step, derived from the material grid: the DC band
-/// scales by e + a(1-e), the linear band by e + a(1-e)g, with e = exp(-σt Δx), a = σs/σt.
+/// Per-cell transport factors of one step, derived from the material grid. Seed scheme:
+/// the DC band scales by e + a(1-e), the linear band by e + a(1-e)g, with
+/// e = exp(-σt Δx), a = σs/σt. Calibrated scheme: see volume/lpv_calibration.h.
 struct StepFactors {
+  LpvScheme scheme = LpvScheme::Seed;
   std::array<std::vector<float>, 3> dc;      ///< per channel, per cell
   std::array<std::vector<float>, 3> linear;  ///< per channel, per cell
+  /// Per channel, per cell: multiplies the exitant radiance shading reads from the cell
+  /// (all 1 in the seed scheme).
+  std::array<std::vector<float>, 3> exitGain;
   std::vector<unsigned char> active;  ///< coverage > 0 and not on the outer ring
   /// Per (y, z) row: does it hold any active cell? Rows without one never hold light and
   /// are skipped, so cost follows the object's cells rather than its bounding box.
   std::vector<unsigned char> rowActive;
 };
-StepFactors computeStepFactors(const MaterialGrid& material);
+StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme = LpvScheme::Seed,
+                               double ior = 1.0);
+
+/// Flux a cell with coefficients (c0, cx, cy, cz) sends through the 5 faces of each of
+/// its 6 neighbours (order -x, +x, -y, +y, -z, +z), clamped as the propagation clamps.
+std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz);
 
 /// Propagates `field` (the injected light, replaced by the last step's light) for the
 /// requested steps and adds every step, including the injected one, into `accumulated`.
@@ -104,7 +115,9 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
 /// LPV half a cell inside the surface, converts intensity to exitant radiance through the
 /// hemisphere integral, and applies the exit Fresnel transmittance (and the 1/η² radiance
 /// change across the boundary). Background pixels are 0.
+/// `exitGain` (StepFactors::exitGain) scales each cell's coefficients; empty = 1.
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
-                 const ShGrid& accumulated, double ior);
+                 const ShGrid& accumulated, double ior,
+                 const std::array<std::vector<float>, 3>* exitGain = nullptr);
 
 }  // namespace sslpv

@@ -188,13 +188,15 @@ glm::dvec3 gridPower(const ShGrid& grid) {
 
 }  // namespace
 
-StepFactors computeStepFactors(const MaterialGrid& material) {
+StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, double ior) {
   const GridFrame& f = material.frame;
   const std::size_t n = f.cellCount();
   StepFactors factors;
+  factors.scheme = scheme;
   for (int ch = 0; ch < 3; ++ch) {
     factors.dc[ch].assign(n, 0.0f);
     factors.linear[ch].assign(n, 0.0f);
+    factors.exitGain[ch].assign(n, 1.0f);
   }
   factors.active.assign(n, 0);
   factors.rowActive.assign(std::size_t(f.dims.y) * f.dims.z, 0);
@@ -208,16 +210,35 @@ StepFactors computeStepFactors(const MaterialGrid& material) {
         factors.rowActive[std::size_t(z) * f.dims.y + y] = 1;
         for (int ch = 0; ch < 3; ++ch) {
           const double sigmaT = material.sigmaT[i][ch], sigmaS = material.sigmaS[i][ch];
-          const double e = std::exp(-sigmaT * dx);
-          // Albedo of an empty cell is irrelevant (e = 1); guard the 0/0.
-          const double albedo = sigmaT > 0.0 ? std::min(1.0, sigmaS / sigmaT) : 1.0;
-          const double scattered = albedo * (1.0 - e);
-          factors.dc[ch][i] = float(e + scattered);
-          factors.linear[ch][i] = float(e + scattered * material.g[i]);
+          const CellTransport t = scheme == LpvScheme::Seed
+                                      ? seedTransport(sigmaT, sigmaS, material.g[i], dx)
+                                      : calibratedTransport(sigmaT, sigmaS, material.g[i], dx, ior);
+          factors.dc[ch][i] = t.dc;
+          factors.linear[ch][i] = t.linear;
+          factors.exitGain[ch][i] = t.exitGain;
         }
       }
   });
   return factors;
+}
+
+std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz) {
+  const float c1[3] = {cx, cy, cz};
+  const float base = c0 * sh::kY00;
+  std::array<float, 6> flux{};
+  for (int a = 0; a < 3; ++a) {
+    const float h1 = (0.5f * sh::kY1 * kSideNorm) * c1[(a + 1) % 3];
+    const float h2 = (0.5f * sh::kY1 * kSideNorm) * c1[(a + 2) % 3];
+    for (int sd = -1; sd <= 1; sd += 2) {
+      const float along = sd * sh::kY1 * c1[a];
+      const float alongSide = base + along * kSideNorm;
+      flux[2 * a + (sd > 0 ? 1 : 0)] =
+          kFront * std::max(0.0f, base + along) +
+          kSide * (std::max(0.0f, alongSide + h1) + std::max(0.0f, alongSide - h1) +
+                   std::max(0.0f, alongSide + h2) + std::max(0.0f, alongSide - h2));
+    }
+  }
+  return flux;
 }
 
 PropagationResult propagate(const MaterialGrid& material, const StepFactors& factors, ShGrid& field,

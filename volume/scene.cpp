@@ -433,7 +433,7 @@ Camera parseCamera(const SceneReader& in, const json& node) {
 LpvSettings parseLpv(const SceneReader& in, const json& node) {
   const std::string path = "lpv";
   in.requireObject(node, path);
-  in.allowOnly(node, path, {"resolution", "steps", "shadow_map"});
+  in.allowOnly(node, path, {"resolution", "steps", "shadow_map", "scheme"});
   LpvSettings lpv;
   if (const json* v = in.optional(node, "resolution"))
     lpv.resolution = in.integer(*v, childPath(path, "resolution"), 2, kMaxLpvResolution);
@@ -450,6 +450,10 @@ LpvSettings parseLpv(const SceneReader& in, const json& node) {
   }
   if (const json* v = in.optional(node, "shadow_map"))
     lpv.shadowMap = in.integer(*v, childPath(path, "shadow_map"), 1, kMaxShadowMap);
+  if (const json* v = in.optional(node, "scheme")) {
+    if (!v->is_string() || !parseLpvScheme(v->get<std::string>(), lpv.scheme))
+      in.fail(childPath(path, "scheme"), "expected \"calibrated\" or \"seed\"");
+  }
   return lpv;
 }
 

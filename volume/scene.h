@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "volume/lpv_calibration.h"
 #include "volume/material.h"
 
 namespace sslpv {
@@ -67,6 +68,7 @@ struct LpvSettings {
   int steps = 8;        ///< propagation steps (ignored when autoSteps)
   bool autoSteps = false;
   int shadowMap = 256;  ///< shadow-map texels per side
+  LpvScheme scheme = LpvScheme::Calibrated;  ///< per-step coefficients (volume/lpv_calibration.h)
 };
 
 struct Scene {

@@ -15,7 +15,7 @@
 namespace sslpv {
 
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
-                 const ShGrid& accumulated, double ior) {
+                 const ShGrid& accumulated, double ior, const std::array<std::vector<float>, 3>* exitGain) {
   Image image(camera.width, camera.height);
   const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
   const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
@@ -57,7 +57,7 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
         for (int ch = 0; ch < 3; ++ch) {
           sh::Coeffs c(0.0f);
           for (int i = 0; i < used; ++i)
-            c += weights[i] * sh::Coeffs(accumulated.plane(ch, 0)[cells[i]], accumulated.plane(ch, 1)[cells[i]],
+            c += weights[i] * (exitGain ? (*exitGain)[ch][cells[i]] : 1.0f) * sh::Coeffs(accumulated.plane(ch, 0)[cells[i]], accumulated.plane(ch, 1)[cells[i]],
                                          accumulated.plane(ch, 2)[cells[i]], accumulated.plane(ch, 3)[cells[i]]);
           const double exitant = std::max(0.0f, sh::hemisphereIntegral(c, glm::vec3(n)));
           radiance[ch] = float(exitant * radianceScale * boundaryScale * transmittance);
