@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 
+#include "apps/cmd_compare.h"
 #ifdef SSLPV_HAVE_VULKAN
 #include "gpu/device.h"
 #include "gpu/vk_check.h"
@@ -41,7 +42,7 @@ int fail(int code, std::string message) {
 }
 
 struct RenderArgs {
-  std::string scene, output, backend = "vulkan", steps;
+  std::string scene, output, backend = "vulkan", steps, scheme;
   std::optional<int> grid, shadowMap;
   bool timings = false;
   float exposure = 1.0f;
@@ -86,6 +87,8 @@ int runRender(const RenderArgs& args) {
       throw InputError("--shadow-map: must be between 1 and " + std::to_string(kMaxShadowMap));
     settings.shadowMap = *args.shadowMap;
   }
+  if (!args.scheme.empty() && !parseLpvScheme(args.scheme, settings.scheme))
+    throw InputError("--scheme: unknown scheme '" + args.scheme + "' (calibrated, seed)");
   if (!(args.exposure > 0.0f)) throw InputError("--exposure: must be positive");
 
   RenderReport report;
@@ -171,6 +174,8 @@ int main(int argc, char** argv) {
   renderCmd->add_option("--grid", render.grid, "LPV cells along the longest axis (overrides lpv.resolution)");
   renderCmd->add_option("--steps", render.steps, "Propagation steps, or 'auto' (overrides lpv.steps)");
   renderCmd->add_option("--shadow-map", render.shadowMap, "Shadow-map texels per side (overrides lpv.shadow_map)");
+  renderCmd->add_option("--scheme", render.scheme,
+                         "Propagation coefficients: calibrated (default) or seed (overrides lpv.scheme)");
   renderCmd->add_option("--exposure", render.exposure, "PNG only: multiply radiance before tone mapping");
   renderCmd->add_flag("--timings", render.timings, "Print the per-stage timing table");
 
@@ -189,6 +194,7 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
 
   // Subcommands from apps/cmd_*.cpp (each: Args struct, add<Name>Command, run<Name>).
+  sslpv::CompareArgs compare; CLI::App* compareCmd = sslpv::addCompareCommand(app, compare);
 
   // CLI11 reports a stray subcommand only as "extra arguments"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {
@@ -215,6 +221,7 @@ int main(int argc, char** argv) {
     if (*renderCmd) return runRender(render);
     if (*referenceCmd) return runReference(reference);
     // Dispatch of the apps/cmd_*.cpp subcommands.
+    if (*compareCmd) return sslpv::runCompare(compare);
     if (*inspectCmd) {
       if (!sslpv::inspectVdbFile(inspectFile, std::cout))
         return fail(kExitInput, inspectFile + ": the material set has validation problems (listed above)");

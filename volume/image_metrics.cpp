@@ -1,0 +1,259 @@
+#include "volume/image_metrics.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace sslpv {
+namespace {
+
+void requireSameSize(const Image& a, const Image& b, const char* where) {
+  if (a.width != b.width || a.height != b.height)
+    throw std::invalid_argument(std::string(where) + ": images are " + std::to_string(a.width) + "x" +
+                                std::to_string(a.height) + " and " + std::to_string(b.width) + "x" +
+                                std::to_string(b.height));
+}
+
+void requireMaskSize(const Image& image, const PixelMask& mask, const char* where) {
+  if (mask.width != image.width || mask.height != image.height ||
+      mask.inside.size() != std::size_t(mask.width) * std::size_t(mask.height))
+    throw std::invalid_argument(std::string(where) + ": the mask is " + std::to_string(mask.width) + "x" +
+                                std::to_string(mask.height) + ", the images " + std::to_string(image.width) +
+                                "x" + std::to_string(image.height));
+}
+
+void requireBlockSize(int width, int height, int k, const char* where) {
+  if (k < 1 || k > std::min(width, height))
+    throw std::invalid_argument(std::string(where) + ": block size " + std::to_string(k) + " for a " +
+                                std::to_string(width) + "x" + std::to_string(height) + " image");
+}
+
+/// Un-normalised 1D Gaussian taps for offsets −R..R.
+std::array<double, 2 * kSsimRadius + 1> gaussianTaps() {
+  std::array<double, 2 * kSsimRadius + 1> taps{};
+  for (int d = -kSsimRadius; d <= kSsimRadius; ++d)
+    taps[std::size_t(d + kSsimRadius)] = std::exp(-double(d * d) / (2.0 * kSsimSigma * kSsimSigma));
+  return taps;
+}
+
+/// Per position along an axis of length n: the sum of the taps that fall inside [0, n).
+/// The 2D window is separable, so the renormalisation of a window cut by the image
+/// border is the product of the two axes' sums.
+std::vector<double> tapSums(int n, const std::array<double, 2 * kSsimRadius + 1>& taps) {
+  std::vector<double> sums(std::size_t(n), 0.0);
+  for (int i = 0; i < n; ++i)
+    for (int d = -kSsimRadius; d <= kSsimRadius; ++d)
+      if (i + d >= 0 && i + d < n) sums[std::size_t(i)] += taps[std::size_t(d + kSsimRadius)];
+  return sums;
+}
+
+/// Separable, un-normalised Gaussian filter of a W×H map; taps outside the image are
+/// skipped (the caller divides by the tap sums).
+std::vector<double> gaussianFilter(const std::vector<double>& map, int width, int height,
+                                   const std::array<double, 2 * kSsimRadius + 1>& taps) {
+  std::vector<double> rows(map.size(), 0.0), out(map.size(), 0.0);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      double sum = 0.0;
+      for (int d = std::max(-kSsimRadius, -x); d <= std::min(kSsimRadius, width - 1 - x); ++d)
+        sum += taps[std::size_t(d + kSsimRadius)] * map[std::size_t(y) * width + std::size_t(x + d)];
+      rows[std::size_t(y) * width + x] = sum;
+    }
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      double sum = 0.0;
+      for (int d = std::max(-kSsimRadius, -y); d <= std::min(kSsimRadius, height - 1 - y); ++d)
+        sum += taps[std::size_t(d + kSsimRadius)] * rows[std::size_t(y + d) * width + x];
+      out[std::size_t(y) * width + x] = sum;
+    }
+  return out;
+}
+
+}  // namespace
+
+std::size_t PixelMask::count() const {
+  return std::size_t(std::count_if(inside.begin(), inside.end(), [](std::uint8_t v) { return v != 0; }));
+}
+
+double luminance(const glm::vec3& rgb) {
+  return 0.2126 * double(rgb.r) + 0.7152 * double(rgb.g) + 0.0722 * double(rgb.b);
+}
+
+PixelMask autoMask(const Image& a, const Image& b) {
+  requireSameSize(a, b, "autoMask");
+  PixelMask mask(a.width, a.height);
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x)
+      mask.set(x, y, a.at(x, y) != glm::vec3(0.0f) || b.at(x, y) != glm::vec3(0.0f));
+  return mask;
+}
+
+PixelMask maskFromImage(const Image& image) {
+  PixelMask mask(image.width, image.height);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const glm::vec3& p = image.at(x, y);
+      mask.set(x, y, p.r > 0.0f || p.g > 0.0f || p.b > 0.0f);
+    }
+  return mask;
+}
+
+std::optional<glm::ivec2> firstNonFinitePixel(const Image& image) {
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const glm::vec3& p = image.at(x, y);
+      if (!std::isfinite(p.r) || !std::isfinite(p.g) || !std::isfinite(p.b)) return glm::ivec2(x, y);
+    }
+  return std::nullopt;
+}
+
+Image blockAverage(const Image& image, int k) {
+  requireBlockSize(image.width, image.height, k, "blockAverage");
+  Image out(image.width / k, image.height / k);
+  const double inv = 1.0 / (double(k) * double(k));
+  for (int by = 0; by < out.height; ++by)
+    for (int bx = 0; bx < out.width; ++bx) {
+      glm::dvec3 sum(0.0);
+      for (int y = by * k; y < (by + 1) * k; ++y)
+        for (int x = bx * k; x < (bx + 1) * k; ++x) sum += glm::dvec3(image.at(x, y));
+      out.at(bx, by) = glm::vec3(sum * inv);
+    }
+  return out;
+}
+
+PixelMask blockMask(const PixelMask& mask, int k) {
+  requireBlockSize(mask.width, mask.height, k, "blockMask");
+  PixelMask out(mask.width / k, mask.height / k);
+  for (int by = 0; by < out.height; ++by)
+    for (int bx = 0; bx < out.width; ++bx) {
+      bool all = true;
+      for (int y = by * k; y < (by + 1) * k && all; ++y)
+        for (int x = bx * k; x < (bx + 1) * k && all; ++x) all = mask.at(x, y);
+      out.set(bx, by, all);
+    }
+  return out;
+}
+
+double ssim(const Image& a, const Image& b, const PixelMask& mask, double range) {
+  requireSameSize(a, b, "ssim");
+  requireMaskSize(a, mask, "ssim");
+  if (!(range > 0.0) || !std::isfinite(range))
+    throw std::invalid_argument("ssim: the dynamic range must be positive, got " + std::to_string(range));
+  const int w = a.width, h = a.height;
+  const std::size_t n = std::size_t(w) * std::size_t(h);
+  std::vector<double> ya(n), yb(n), yaa(n), ybb(n), yab(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    ya[i] = luminance(a.pixels[i]);
+    yb[i] = luminance(b.pixels[i]);
+    yaa[i] = ya[i] * ya[i];
+    ybb[i] = yb[i] * yb[i];
+    yab[i] = ya[i] * yb[i];
+  }
+  const auto taps = gaussianTaps();
+  const std::vector<double> sumX = tapSums(w, taps), sumY = tapSums(h, taps);
+  const std::vector<double> fa = gaussianFilter(ya, w, h, taps), fb = gaussianFilter(yb, w, h, taps);
+  const std::vector<double> faa = gaussianFilter(yaa, w, h, taps), fbb = gaussianFilter(ybb, w, h, taps);
+  const std::vector<double> fab = gaussianFilter(yab, w, h, taps);
+  const double c1 = (kSsimK1 * range) * (kSsimK1 * range);
+  const double c2 = (kSsimK2 * range) * (kSsimK2 * range);
+  double total = 0.0;
+  std::size_t windows = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (!mask.at(x, y)) continue;
+      const std::size_t i = std::size_t(y) * w + x;
+      const double norm = 1.0 / (sumX[std::size_t(x)] * sumY[std::size_t(y)]);
+      const double mu_a = fa[i] * norm, mu_b = fb[i] * norm;
+      const double var_a = faa[i] * norm - mu_a * mu_a;
+      const double var_b = fbb[i] * norm - mu_b * mu_b;
+      const double cov = fab[i] * norm - mu_a * mu_b;
+      total += ((2.0 * mu_a * mu_b + c1) * (2.0 * cov + c2)) /
+               ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
+      ++windows;
+    }
+  if (windows == 0) throw std::invalid_argument("ssim: the mask is empty");
+  return total / double(windows);
+}
+
+ImageMetrics computeImageMetrics(const Image& a, const Image& b, const PixelMask& mask) {
+  requireSameSize(a, b, "computeImageMetrics");
+  requireMaskSize(a, mask, "computeImageMetrics");
+  if (firstNonFinitePixel(a) || firstNonFinitePixel(b))
+    throw std::invalid_argument("computeImageMetrics: non-finite pixel");
+  ImageMetrics m;
+  m.width = a.width;
+  m.height = a.height;
+  m.maskPixels = mask.count();
+  if (m.maskPixels == 0) throw std::invalid_argument("computeImageMetrics: the mask is empty");
+
+  // First pass: the means, which set the floors of the relative metrics and L.
+  glm::dvec3 sumA(0.0), sumB(0.0);
+  double maxLuminanceB = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    if (!mask.inside[i]) continue;
+    sumA += glm::dvec3(a.pixels[i]);
+    sumB += glm::dvec3(b.pixels[i]);
+    maxLuminanceB = std::max(maxLuminanceB, luminance(b.pixels[i]));
+  }
+  const double pixels = double(m.maskPixels), samples = 3.0 * pixels;
+  m.meanARgb = sumA / pixels;
+  m.meanBRgb = sumB / pixels;
+  m.meanA = (sumA.r + sumA.g + sumA.b) / samples;
+  m.meanB = (sumB.r + sumB.g + sumB.b) / samples;
+  if (!(m.meanB > 0.0))
+    throw std::invalid_argument("computeImageMetrics: the reference's mean over the mask is not positive");
+  if (!(maxLuminanceB > 0.0))
+    throw std::invalid_argument("computeImageMetrics: the reference has no positive luminance in the mask");
+  m.meanRatio = m.meanA / m.meanB;
+  m.relativeFloor = kRelativeFloorFraction * m.meanB;
+  m.relativeMseEpsilon = m.relativeFloor * m.relativeFloor;
+
+  double squared = 0.0, relativeSquared = 0.0, relative = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    if (!mask.inside[i]) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double va = a.pixels[i][c], vb = b.pixels[i][c];
+      const double d = va - vb;
+      squared += d * d;
+      relativeSquared += d * d / (vb * vb + m.relativeMseEpsilon);
+      relative += std::abs(d) / std::max(std::abs(vb), m.relativeFloor);
+    }
+  }
+  m.rmse = std::sqrt(squared / samples);
+  m.relativeMse = relativeSquared / samples;
+  m.meanRelativeError = relative / samples;
+  m.ssimRange = maxLuminanceB;
+  m.ssim = ssim(a, b, mask, m.ssimRange);
+  return m;
+}
+
+std::string compareJson(const CompareSource& source, const ImageMetrics& m) {
+  const nlohmann::ordered_json record = {
+      {"a", source.a},
+      {"b", source.b},
+      {"mask", source.mask},
+      {"width", source.width},
+      {"height", source.height},
+      {"block", source.block},
+      {"metric_width", m.width},
+      {"metric_height", m.height},
+      {"mask_pixels", m.maskPixels},
+      {"mean_a", m.meanA},
+      {"mean_b", m.meanB},
+      {"mean_ratio", m.meanRatio},
+      {"mean_a_rgb", {m.meanARgb.r, m.meanARgb.g, m.meanARgb.b}},
+      {"mean_b_rgb", {m.meanBRgb.r, m.meanBRgb.g, m.meanBRgb.b}},
+      {"rmse", m.rmse},
+      {"relative_mse", m.relativeMse},
+      {"relative_mse_epsilon", m.relativeMseEpsilon},
+      {"mean_relative_error", m.meanRelativeError},
+      {"relative_error_floor", m.relativeFloor},
+      {"ssim", m.ssim},
+      {"ssim_range", m.ssimRange},
+  };
+  return record.dump(2) + "\n";
+}
+
+}  // namespace sslpv
