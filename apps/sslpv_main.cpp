@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "apps/cmd_compare.h"
+#include "apps/cmd_export.h"
 #ifdef SSLPV_HAVE_VULKAN
 #include "gpu/device.h"
 #include "gpu/vk_check.h"
@@ -194,6 +195,7 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
 
   // Subcommands from apps/cmd_*.cpp (each: Args struct, add<Name>Command, run<Name>).
+  sslpv::ExportArgs exportArgs; CLI::App* exportCmd = sslpv::addExportCommand(app, exportArgs);
   sslpv::CompareArgs compare; CLI::App* compareCmd = sslpv::addCompareCommand(app, compare);
 
   // CLI11 reports a stray subcommand only as "extra arguments"; name it instead.
@@ -221,6 +223,7 @@ int main(int argc, char** argv) {
     if (*renderCmd) return runRender(render);
     if (*referenceCmd) return runReference(reference);
     // Dispatch of the apps/cmd_*.cpp subcommands.
+    if (*exportCmd) return sslpv::runExport(exportArgs);
     if (*compareCmd) return sslpv::runCompare(compare);
     if (*inspectCmd) {
       if (!sslpv::inspectVdbFile(inspectFile, std::cout))
