@@ -1,0 +1,449 @@
+// Stroke files (format in stroke_io.h): strict parsing with key paths in every message.
+#include "editor/stroke_io.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string_view>
+#include <utility>
+
+#include "volume/error.h"
+
+namespace sslpv {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Keys and strings are echoed into one-line messages: control characters must not break it.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::string childPath(const std::string& path, std::string_view key) {
+  return path.empty() ? printable(key) : path + "." + printable(key);
+}
+std::string indexPath(const std::string& path, std::size_t index) { return path + "[" + std::to_string(index) + "]"; }
+
+std::string formatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", value);
+  return text;
+}
+
+std::string describeType(const json& value) {
+  switch (value.type()) {
+    case json::value_t::null:
+      return "null";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return "a boolean";
+    case json::value_t::binary:
+      return "binary data";
+    case json::value_t::discarded:
+      return "nothing";
+    default:
+      return "a number";
+  }
+}
+
+std::string quotedList(std::initializer_list<const char*> names) {
+  std::string out;
+  for (const char* name : names) out += std::string(out.empty() ? "" : ", ") + "\"" + name + "\"";
+  return out;
+}
+
+/// Follows the parser through the document, so that a syntax error (NaN, a stray token) and
+/// a duplicated key can be reported at the key path where they occur.
+class PathTracker {
+ public:
+  explicit PathTracker(const fs::path& file) : file_(file) {}
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        frames_->push_back({false, 0, {}, false, {}});
+        break;
+      case json::parse_event_t::array_start:
+        frames_->push_back({true, 0, {}, false, {}});
+        break;
+      case json::parse_event_t::key: {
+        Frame& top = frames_->back();
+        top.key = parsed.get<std::string>();
+        top.hasKey = true;
+        if (!top.keys.insert(top.key).second) throw InputError(file_.string() + ": " + path() + ": duplicate key");
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_->pop_back();
+        completeValue();
+        break;
+      case json::parse_event_t::value:
+        completeValue();
+        break;
+    }
+    return true;
+  }
+  /// The key path of the value being parsed.
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : *frames_) {
+      if (f.isArray)
+        out = indexPath(out, f.index);
+      else if (f.hasKey)
+        out = childPath(out, f.key);
+    }
+    return out;
+  }
+
+ private:
+  struct Frame {
+    bool isArray;
+    std::size_t index;
+    std::string key;
+    bool hasKey;
+    std::set<std::string> keys;
+  };
+  void completeValue() {
+    if (frames_->empty()) return;
+    Frame& top = frames_->back();
+    if (top.isArray)
+      ++top.index;
+    else
+      top.hasKey = false;
+  }
+  const fs::path& file_;
+  // Shared: nlohmann copies the callback, the caller keeps a copy to ask for the path.
+  std::shared_ptr<std::vector<Frame>> frames_ = std::make_shared<std::vector<Frame>>();
+};
+
+class Reader {
+ public:
+  explicit Reader(const fs::path& file) : file_(file) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
+    throw InputError(file_.string() + ": " + (path.empty() ? "" : path + ": ") + reason);
+  }
+  void requireObject(const json& v, const std::string& path) const {
+    if (!v.is_object()) fail(path, "expected an object, got " + describeType(v));
+  }
+  void allowOnly(const json& object, const std::string& path, std::initializer_list<const char*> accepted) const {
+    for (const auto& item : object.items()) {
+      bool known = false;
+      for (const char* name : accepted) known = known || item.key() == name;
+      if (!known) fail(childPath(path, item.key()), "unknown key (accepted keys: " + quotedList(accepted) + ")");
+    }
+  }
+  const json* optional(const json& object, const char* key) const {
+    auto it = object.find(key);
+    return it == object.end() ? nullptr : &*it;
+  }
+  const json& required(const json& object, const std::string& path, const char* key) const {
+    auto it = object.find(key);
+    if (it == object.end()) fail(path, std::string("missing required key \"") + key + "\"");
+    return *it;
+  }
+  double number(const json& v, const std::string& path) const {
+    if (!v.is_number()) fail(path, "expected a number, got " + describeType(v));
+    const double result = v.get<double>();
+    if (!std::isfinite(result)) fail(path, "expected a finite number");
+    return result;
+  }
+  std::string string(const json& v, const std::string& path) const {
+    if (!v.is_string()) fail(path, "expected a string, got " + describeType(v));
+    return v.get<std::string>();
+  }
+  glm::dvec3 vec3(const json& v, const std::string& path) const {
+    if (!v.is_array() || v.size() != 3)
+      fail(path, "expected an array of 3 numbers, got " +
+                     (v.is_array() ? "an array of " + std::to_string(v.size()) : describeType(v)));
+    glm::dvec3 result;
+    for (std::size_t i = 0; i < 3; ++i) result[int(i)] = number(v[i], indexPath(path, i));
+    return result;
+  }
+  /// [r,g,b] or one number for all three channels, each in [lo, hi].
+  glm::dvec3 rgb(const json& v, const std::string& path, double lo, double hi, const char* range) const {
+    if (v.is_number()) {
+      const double x = number(v, path);
+      if (!(x >= lo && x <= hi)) fail(path, std::string("must be ") + range + ", got " + formatNumber(x));
+      return glm::dvec3(x);
+    }
+    if (!v.is_array()) fail(path, "expected a number or an array of 3 numbers, got " + describeType(v));
+    const glm::dvec3 result = vec3(v, path);
+    for (int i = 0; i < 3; ++i)
+      if (!(result[i] >= lo && result[i] <= hi))
+        fail(indexPath(path, std::size_t(i)), std::string("must be ") + range + ", got " + formatNumber(result[i]));
+    return result;
+  }
+  template <class Enum>
+  Enum choice(const json& v, const std::string& path, const char* what,
+              std::initializer_list<std::pair<const char*, Enum>> options) const {
+    const std::string text = string(v, path);
+    std::string accepted;
+    for (const auto& [name, value] : options) {
+      if (text == name) return value;
+      accepted += std::string(accepted.empty() ? "" : ", ") + "\"" + name + "\"";
+    }
+    fail(path, "unknown " + std::string(what) + " \"" + printable(text) + "\" (accepted: " + accepted + ")");
+  }
+
+ private:
+  const fs::path& file_;
+};
+
+constexpr double kInf = HUGE_VAL;
+
+const std::initializer_list<std::pair<const char*, BrushChannel>> kChannelNames = {
+    {"sigma_t", BrushChannel::SigmaT},
+    {"sigma_s", BrushChannel::SigmaS},
+    {"g", BrushChannel::G},
+    {"albedo_mfp", BrushChannel::AlbedoMfp},
+    {"preset", BrushChannel::Preset}};
+const std::initializer_list<std::pair<const char*, BrushMode>> kModeNames = {{"set", BrushMode::Set},
+                                                                             {"add", BrushMode::Add},
+                                                                             {"multiply", BrushMode::Multiply},
+                                                                             {"smooth", BrushMode::Smooth},
+                                                                             {"erase", BrushMode::Erase}};
+const std::initializer_list<std::pair<const char*, BrushFalloff>> kFalloffNames = {
+    {"constant", BrushFalloff::Constant},
+    {"linear", BrushFalloff::Linear},
+    {"smooth", BrushFalloff::Smooth},
+    {"gaussian", BrushFalloff::Gaussian}};
+const std::initializer_list<std::pair<const char*, int>> kAxisNames = {{"x", 0}, {"y", 1}, {"z", 2}};
+
+template <class Enum>
+const char* nameOf(std::initializer_list<std::pair<const char*, Enum>> names, Enum value) {
+  for (const auto& [name, v] : names)
+    if (v == value) return name;
+  return "";
+}
+
+void parseValue(const Reader& in, const json& v, const std::string& path, Brush& b) {
+  const bool set = b.mode == BrushMode::Set, multiply = b.mode == BrushMode::Multiply;
+  switch (b.channel) {
+    case BrushChannel::SigmaT:
+    case BrushChannel::SigmaS:
+      b.rgb = set        ? in.rgb(v, path, 0.0, kInf, "a non-negative sigma")
+              : multiply ? in.rgb(v, path, 0.0, kInf, "a non-negative factor")
+                         : in.rgb(v, path, -kInf, kInf, "finite");
+      break;
+    case BrushChannel::G:
+      b.scalar = in.number(v, path);
+      if (set && !(std::abs(b.scalar) <= double(kBrushMaxG)))
+        in.fail(path, "g must be in [-0.99, 0.99], got " + formatNumber(b.scalar));
+      break;
+    case BrushChannel::AlbedoMfp:
+      in.requireObject(v, path);
+      in.allowOnly(v, path, {"albedo", "mean_free_path"});
+      b.albedo = in.rgb(in.required(v, path, "albedo"), childPath(path, "albedo"), 0.0, 1.0, "in [0, 1]");
+      b.meanFreePath = in.rgb(in.required(v, path, "mean_free_path"), childPath(path, "mean_free_path"),
+                              std::nextafter(0.0, 1.0), kInf, "positive");
+      break;
+    case BrushChannel::Preset:
+      b.preset = in.string(v, path);
+      if (!presetMaterial(b.preset, 0.0f, 1.0))
+        in.fail(path, "unknown preset \"" + printable(b.preset) + "\" (accepted: " + presetNames() + ")");
+      break;
+    case BrushChannel::All:
+      break;
+  }
+}
+
+Stroke parseStroke(const Reader& in, const json& node, const std::string& path) {
+  in.requireObject(node, path);
+  in.allowOnly(node, path,
+               {"channel", "mode", "value", "radius", "falloff", "strength", "mirror", "points", "rays", "depth"});
+  Stroke stroke;
+  Brush& b = stroke.brush;
+  b.mode = in.choice(in.required(node, path, "mode"), childPath(path, "mode"), "mode", kModeNames);
+  const bool valued = b.mode == BrushMode::Set || b.mode == BrushMode::Add || b.mode == BrushMode::Multiply;
+  const char* modeName = nameOf(kModeNames, b.mode);
+  if (const json* v = in.optional(node, "channel")) {
+    b.channel = in.choice(*v, childPath(path, "channel"), "channel", kChannelNames);
+  } else if (valued) {
+    in.fail(path, std::string("missing required key \"channel\" (mode \"") + modeName + "\" needs one)");
+  }
+  if ((b.channel == BrushChannel::AlbedoMfp || b.channel == BrushChannel::Preset) && b.mode != BrushMode::Set)
+    in.fail(childPath(path, "mode"), std::string("channel \"") + nameOf(kChannelNames, b.channel) +
+                                         "\" takes mode \"set\" only, got \"" + modeName + "\"");
+  if (const json* v = in.optional(node, "value")) {
+    if (!valued) in.fail(childPath(path, "value"), std::string("not used by mode \"") + modeName + "\" (remove it)");
+    parseValue(in, *v, childPath(path, "value"), b);
+  } else if (valued) {
+    in.fail(path, std::string("missing required key \"value\" (mode \"") + modeName + "\" needs one)");
+  }
+  const std::string radiusPath = childPath(path, "radius");
+  b.radius = in.number(in.required(node, path, "radius"), radiusPath);
+  if (!(b.radius > 0.0)) in.fail(radiusPath, "must be positive, got " + formatNumber(b.radius));
+  if (const json* v = in.optional(node, "falloff"))
+    b.falloff = in.choice(*v, childPath(path, "falloff"), "falloff", kFalloffNames);
+  if (const json* v = in.optional(node, "strength")) {
+    b.strength = in.number(*v, childPath(path, "strength"));
+    if (!(b.strength >= 0.0 && b.strength <= 1.0))
+      in.fail(childPath(path, "strength"), "must be in [0, 1], got " + formatNumber(b.strength));
+  }
+  if (const json* v = in.optional(node, "mirror")) {
+    const std::string mirrorPath = childPath(path, "mirror");
+    in.requireObject(*v, mirrorPath);
+    in.allowOnly(*v, mirrorPath, {"axis", "at"});
+    BrushMirror mirror;
+    mirror.axis = in.choice(in.required(*v, mirrorPath, "axis"), childPath(mirrorPath, "axis"), "axis", kAxisNames);
+    if (const json* at = in.optional(*v, "at")) mirror.at = in.number(*at, childPath(mirrorPath, "at"));
+    b.mirror = mirror;
+  }
+
+  const json* points = in.optional(node, "points");
+  const json* rays = in.optional(node, "rays");
+  if (!points == !rays) in.fail(path, "expected exactly one of \"points\" and \"rays\"");
+  if (points) {
+    const std::string p = childPath(path, "points");
+    if (!points->is_array() || points->empty())
+      in.fail(p, "expected a non-empty array of [x,y,z] points, got " + describeType(*points));
+    for (std::size_t i = 0; i < points->size(); ++i) stroke.points.push_back(in.vec3((*points)[i], indexPath(p, i)));
+    if (in.optional(node, "depth")) in.fail(childPath(path, "depth"), "only used with \"rays\"");
+  } else {
+    const std::string p = childPath(path, "rays");
+    if (!rays->is_array() || rays->empty())
+      in.fail(p, "expected a non-empty array of rays, got " + describeType(*rays));
+    for (std::size_t i = 0; i < rays->size(); ++i) {
+      const json& ray = (*rays)[i];
+      const std::string rp = indexPath(p, i);
+      in.requireObject(ray, rp);
+      in.allowOnly(ray, rp, {"origin", "direction"});
+      SurfaceRay r;
+      r.origin = in.vec3(in.required(ray, rp, "origin"), childPath(rp, "origin"));
+      r.direction = in.vec3(in.required(ray, rp, "direction"), childPath(rp, "direction"));
+      if (!(r.direction.x != 0.0 || r.direction.y != 0.0 || r.direction.z != 0.0))
+        in.fail(childPath(rp, "direction"), "must be a non-zero vector");
+      stroke.rays.push_back(r);
+    }
+    if (const json* v = in.optional(node, "depth")) {
+      b.depth = in.number(*v, childPath(path, "depth"));
+      if (!(b.depth >= 0.0)) in.fail(childPath(path, "depth"), "must be non-negative, got " + formatNumber(b.depth));
+    }
+  }
+  // A safety net: the engine's own checks must agree with the ones above.
+  if (std::string problem = brushProblem(b); !problem.empty()) in.fail(path, problem);
+  return stroke;
+}
+
+nlohmann::ordered_json rgbJson(const glm::dvec3& v) { return nlohmann::ordered_json::array({v.x, v.y, v.z}); }
+
+}  // namespace
+
+std::vector<Stroke> parseStrokes(const std::string& jsonText, const fs::path& file) {
+  if (jsonText.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(file.string() + ": empty file");
+  PathTracker tracker(file);
+  json root;
+  try {
+    root = json::parse(jsonText, tracker);
+  } catch (const json::parse_error& e) {
+    std::string reason = e.what();
+    // "[json.exception.parse_error.101] parse error at line 1, column 2: syntax error ..."
+    if (auto at = reason.find("parse error"); at != std::string::npos) reason = reason.substr(at);
+    const std::string path = tracker.path();
+    throw InputError(file.string() + ": " + (path.empty() ? "" : path + ": ") + "malformed JSON (" + printable(reason) +
+                     ")");
+  } catch (const json::exception& e) {
+    throw InputError(file.string() + ": malformed JSON (" + printable(e.what()) + ")");
+  }
+  Reader in(file);
+  if (!root.is_object()) in.fail("", "expected a JSON object at the top level, got " + describeType(root));
+  in.allowOnly(root, "", {"strokes"});
+  const json& strokes = in.required(root, "", "strokes");
+  if (!strokes.is_array()) in.fail("strokes", "expected an array of strokes, got " + describeType(strokes));
+  std::vector<Stroke> result;
+  for (std::size_t i = 0; i < strokes.size(); ++i)
+    result.push_back(parseStroke(in, strokes[i], indexPath("strokes", i)));
+  return result;
+}
+
+std::vector<Stroke> loadStrokes(const fs::path& file) {
+  auto cannotRead = [&](int error) {
+    return InputError(file.string() + ": cannot read stroke file (" + std::strerror(error) + ")");
+  };
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) throw cannotRead(EISDIR);
+  std::FILE* stream = std::fopen(file.c_str(), "rb");
+  if (!stream) throw cannotRead(errno);
+  std::string text;
+  char buffer[65536];
+  std::size_t got = 0;
+  while ((got = std::fread(buffer, 1, sizeof buffer, stream)) > 0) text.append(buffer, got);
+  const int readError = std::ferror(stream) ? errno : 0;
+  std::fclose(stream);
+  if (readError != 0) throw cannotRead(readError);
+  return parseStrokes(text, file);
+}
+
+std::string formatStrokes(const std::vector<Stroke>& strokes) {
+  using ojson = nlohmann::ordered_json;
+  ojson list = ojson::array();
+  for (const Stroke& stroke : strokes) {
+    const Brush& b = stroke.brush;
+    ojson s = ojson::object();
+    if (b.channel != BrushChannel::All) s["channel"] = nameOf(kChannelNames, b.channel);
+    s["mode"] = nameOf(kModeNames, b.mode);
+    if (b.mode == BrushMode::Set || b.mode == BrushMode::Add || b.mode == BrushMode::Multiply) {
+      switch (b.channel) {
+        case BrushChannel::SigmaT:
+        case BrushChannel::SigmaS:
+          s["value"] = rgbJson(b.rgb);
+          break;
+        case BrushChannel::G:
+          s["value"] = b.scalar;
+          break;
+        case BrushChannel::AlbedoMfp:
+          s["value"] = {{"albedo", rgbJson(b.albedo)}, {"mean_free_path", rgbJson(b.meanFreePath)}};
+          break;
+        case BrushChannel::Preset:
+          s["value"] = b.preset;
+          break;
+        case BrushChannel::All:
+          break;
+      }
+    }
+    s["radius"] = b.radius;
+    s["falloff"] = nameOf(kFalloffNames, b.falloff);
+    s["strength"] = b.strength;
+    if (b.mirror) {
+      ojson mirror = {{"axis", nameOf(kAxisNames, b.mirror->axis)}};
+      if (b.mirror->at) mirror["at"] = *b.mirror->at;
+      s["mirror"] = mirror;
+    }
+    if (!stroke.rays.empty()) {
+      ojson rays = ojson::array();
+      for (const SurfaceRay& r : stroke.rays)
+        rays.push_back({{"origin", rgbJson(r.origin)}, {"direction", rgbJson(r.direction)}});
+      s["rays"] = rays;
+      if (b.depth != 0.0) s["depth"] = b.depth;
+    } else {
+      ojson points = ojson::array();
+      for (const glm::dvec3& p : stroke.points) points.push_back(rgbJson(p));
+      s["points"] = points;
+    }
+    list.push_back(s);
+  }
+  return ojson{{"strokes", list}}.dump(1) + "\n";
+}
+
+}  // namespace sslpv

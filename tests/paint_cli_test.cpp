@@ -1,0 +1,232 @@
+// `sslpv paint SCENE.json --strokes STROKES.json -o OUT.vdb` end to end: the written set
+// equals the brush engine's own result bit for bit and hand-computed values at chosen
+// voxels; bad stroke files exit 2 with one line naming the key path and leave an existing
+// output untouched.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "editor/brush_engine.h"
+#include "editor/stroke_io.h"
+#include "test_support.h"
+#include "volume/material_set.h"
+#include "volume/scene.h"
+
+namespace sslpv::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using openvdb::Coord;
+
+const std::string kPreexisting = "not a vdb: bytes a failed run must leave untouched\n";
+
+/// Box [-5,5]^3 scaled by 2, rotated 30 degrees about y, moved to (1,2,3): voxel size
+/// 10 / 128 = 0.078125 in rest space (exact in binary).
+json sceneJson() {
+  return json::parse(R"({
+    "units": "mm",
+    "mesh": {"primitive": "box", "min": [-5, -5, -5], "max": [5, 5, 5]},
+    "transform": {"translate": [1, 2, 3], "rotate_deg": [0, 30, 0], "scale": 2},
+    "material": {"base": {"sigma_t": [1.0, 1.2, 1.4], "sigma_s": [0.9, 1.0, 1.1], "g": 0.1}},
+    "lights": [{"type": "point", "position": [20, 30, 40], "intensity": [1000, 1000, 1000]}],
+    "camera": {"position": [0, 10, 40], "target": [0, 0, 0], "fov_y_deg": 35, "width": 64, "height": 64}
+  })");
+}
+
+json worldPoint(const glm::dmat4& restToWorld, const glm::dvec3& rest) {
+  const glm::dvec3 w(restToWorld * glm::dvec4(rest, 1.0));
+  return json::array({w.x, w.y, w.z});
+}
+
+struct Files {
+  TempDir dir;
+  fs::path scene = dir / "scene.json", strokes = dir / "strokes.json", output = dir / "out.vdb";
+};
+
+bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+template <class GridT>
+::testing::AssertionResult sameGrid(const GridT& a, const GridT& b, const char* name) {
+  openvdb::CoordBBox box, other;
+  a.tree().evalLeafBoundingBox(box);
+  if (b.tree().evalLeafBoundingBox(other)) box.expand(other);
+  if (a.activeVoxelCount() != b.activeVoxelCount())
+    return ::testing::AssertionFailure() << name << ": active voxel counts " << a.activeVoxelCount() << " vs "
+                                         << b.activeVoxelCount();
+  auto accA = a.getConstAccessor();
+  auto accB = b.getConstAccessor();
+  for (auto it = box.begin(); it && !box.empty(); ++it) {
+    typename GridT::ValueType va, vb;
+    const bool onA = accA.probeValue(*it, va), onB = accB.probeValue(*it, vb);
+    if (onA != onB || std::memcmp(&va, &vb, sizeof va) != 0)
+      return ::testing::AssertionFailure() << name << " voxel " << *it << " differs";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+TEST(PaintCli, WritesExactlyWhatTheEngineComputesAndTheHandExpectedValues) {
+  Files f;
+  writeText(f.scene, sceneJson().dump());
+  const glm::dmat4 restToWorld = loadScene(f.scene).transform.matrix();
+  const json strokes = {
+      {"strokes",
+       {{{"channel", "sigma_t"},
+         {"mode", "set"},
+         {"value", {4, 5, 6}},
+         {"radius", 0.5},
+         {"falloff", "constant"},
+         {"points", {worldPoint(restToWorld, glm::dvec3(0.0))}}},
+        {{"channel", "g"},
+         {"mode", "set"},
+         {"value", 0.5},
+         {"radius", 0.5},
+         {"strength", 0.5},
+         {"points", {worldPoint(restToWorld, glm::dvec3(1, 0, 0))}}},
+        {{"channel", "albedo_mfp"},
+         {"mode", "set"},
+         {"value", {{"albedo", {0.9, 0.5, 0.2}}, {"mean_free_path", 0.4}}},
+         {"radius", 0.6},
+         {"falloff", "gaussian"},
+         {"mirror", {{"axis", "x"}}},
+         {"points", {worldPoint(restToWorld, {2, 1, -1}), worldPoint(restToWorld, {3, 2, 0})}}},
+        {{"channel", "sigma_s"},
+         {"mode", "add"},
+         {"value", 0.3},
+         {"radius", 0.4},
+         {"depth", 0.5},
+         {"rays",
+          {{{"origin", {1.2, 20, 3.1}}, {"direction", {0, -1, 0}}},
+           {{"origin", {2.0, 20, 3.5}}, {"direction", {0.01, -1, 0}}}}}},
+        {{"mode", "smooth"}, {"radius", 0.8}, {"points", {worldPoint(restToWorld, {2.5, 1.5, -0.5})}}},
+        {{"mode", "erase"},
+         {"radius", 0.3},
+         {"falloff", "linear"},
+         {"points", {worldPoint(restToWorld, {3, 2, 0})}}}}}};
+  writeText(f.strokes, strokes.dump());
+  writeText(f.output, kPreexisting);  // a successful run replaces it
+  const RunResult run = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", f.output.string()});
+  ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+  EXPECT_NE(run.stdoutText.find("stroke 5:"), std::string::npos) << run.stdoutText;
+
+  // The same strokes through the engine in this process.
+  BrushEngine engine(makePaintTarget(loadScene(f.scene)));
+  for (const Stroke& stroke : loadStrokes(f.strokes)) EXPECT_GT(engine.applyStroke(stroke).voxelsChanged, 0u);
+  const MaterialSet& direct = *engine.materialSet();
+  const std::shared_ptr<const MaterialSet> written = loadMaterialSet(f.output);
+  EXPECT_EQ(written->units, "mm");
+  EXPECT_EQ(written->creator, "sslpv paint");
+  EXPECT_TRUE(sameGrid(*written->sigmaT, *direct.sigmaT, "sigma_t"));
+  EXPECT_TRUE(sameGrid(*written->sigmaS, *direct.sigmaS, "sigma_s"));
+  ASSERT_TRUE(written->g);
+  EXPECT_TRUE(sameGrid(*written->g, *direct.g, "g"));
+  EXPECT_DOUBLE_EQ(written->sigmaT->voxelSize()[0], 10.0 / 128.0);
+
+  // By hand. Stroke 0, constant falloff, strength 1: the voxel at the dab centre holds the
+  // target exactly, with the base's σs; the voxel 4 voxels (0.3125 > 0.5/2 rest) away
+  // stays base (inactive).
+  auto t = written->sigmaT->getConstAccessor();
+  auto s = written->sigmaS->getConstAccessor();
+  auto g = written->g->getConstAccessor();
+  openvdb::Vec3s value;
+  ASSERT_TRUE(t.probeValue(Coord(0, 0, 0), value));
+  EXPECT_TRUE(sameBits(value[0], 4.0f) && sameBits(value[1], 5.0f) && sameBits(value[2], 6.0f));
+  ASSERT_TRUE(s.probeValue(Coord(0, 0, 0), value));
+  EXPECT_TRUE(sameBits(value[0], 0.9f) && sameBits(value[1], 1.0f) && sameBits(value[2], 1.1f));
+  EXPECT_FALSE(t.isValueOn(Coord(4, 0, 0)));
+  // Stroke 1, smooth falloff, strength 0.5 at rest (1,0,0) = index (12.8,0,0): voxel
+  // (13,0,0) is 0.015625 away, u = 0.0625, w = 1 - u²(3 - 2u) = 0.98876953125, so
+  // g = 0.1 + 0.5 w (0.5 - 0.1) = 0.29775390625.
+  float gValue = 0.0f;
+  ASSERT_TRUE(g.probeValue(Coord(13, 0, 0), gValue));
+  EXPECT_NEAR(gValue, 0.29775390625, 1e-7);
+  // Stroke 2's mirror (x = 0, the box's rest centre) painted the reflection of its path.
+  // Rest (2,1,-1) = index (25.6,12.8,-12.8); the plane is index 0.
+  openvdb::Vec3s right, left;
+  ASSERT_TRUE(t.probeValue(Coord(26, 13, -13), right));
+  ASSERT_TRUE(t.probeValue(Coord(-26, 13, -13), left));
+  EXPECT_EQ(right, left);
+  EXPECT_GT(right[0], 1.0f);
+}
+
+TEST(PaintCli, PaintsAnExistingSetInItsOwnUnits) {
+  // The scene's set stores σ per cm (scene in mm): painting σt = 2 per mm stores 20 per cm;
+  // an untouched active voxel and the file's units survive.
+  Files f;
+  auto set = makeEmptyMaterialSet(MaterialSample{}, 0.25, "cm");
+  set->sigmaT->tree().setValueOn(Coord(12, 0, 0), openvdb::Vec3s(7.0f));
+  set->sigmaS->tree().setValueOn(Coord(12, 0, 0), openvdb::Vec3s(3.0f));
+  saveMaterialSet(*set, f.dir / "in.vdb");
+  json scene = sceneJson();
+  scene["material"]["vdb"] = "in.vdb";
+  writeText(f.scene, scene.dump());
+  const glm::dmat4 restToWorld = loadScene(f.scene).transform.matrix();
+  writeText(f.strokes, json({{"strokes",
+                              {{{"channel", "sigma_t"},
+                                {"mode", "set"},
+                                {"value", 2},
+                                {"radius", 0.2},
+                                {"falloff", "constant"},
+                                {"points", {worldPoint(restToWorld, {0, 0, 0})}}}}}})
+                           .dump());
+  const RunResult run = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", f.output.string()});
+  ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+  const std::shared_ptr<const MaterialSet> out = loadMaterialSet(f.output);
+  EXPECT_EQ(out->units, "cm");
+  EXPECT_EQ(out->sigmaT->tree().getValue(Coord(0)), openvdb::Vec3s(20.0f));
+  EXPECT_EQ(out->sigmaT->tree().getValue(Coord(12, 0, 0)), openvdb::Vec3s(7.0f));
+  EXPECT_EQ(out->sigmaT->activeVoxelCount(), 2u);
+}
+
+TEST(PaintCli, BadStrokeFilesExit2WithOneLineNamingTheKeyAndLeaveTheOutputUntouched) {
+  const std::string point = R"("points": [[1, 2, 3]])";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"strokes": [{"mode": "erase", "radius": 1, )" + point + R"(}, {"mode": "erase", "radiuss": 1, )" + point +
+           "}]}",
+       "strokes[1].radiuss: unknown key"},
+      {R"({"strokes": [{"mode": "erase", "radius": [1], )" + point + "}]}", "strokes[0].radius: expected a number"},
+      {R"({"strokes": [{"mode": "erase", "radius": 0, )" + point + "}]}", "strokes[0].radius: must be positive"},
+      {R"({"strokes": [{"channel": "preset", "mode": "set", "value": "jade", "radius": 1, )" + point + "}]}",
+       "strokes[0].value: unknown preset"},
+      {R"({"strokes": [{"mode": "erase", "radius": NaN, )" + point + "}]}", "strokes[0].radius: malformed JSON"},
+      {R"({"strokes": [{"mode": "erase", "radius": 1e6, )" + point + "}]}", "strokes[0].radius: a dab covers"},
+      {R"({"strokes": [{"mode": "smooth", "strength": 2, "radius": 1, )" + point + "}]}", "strokes[0].strength"},
+  };
+  for (const auto& [text, expected] : cases) {
+    Files f;
+    writeText(f.scene, sceneJson().dump());
+    writeText(f.strokes, text);
+    writeText(f.output, kPreexisting);
+    const RunResult run =
+        runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", f.output.string()});
+    EXPECT_EQ(run.exitCode, 2) << text;
+    EXPECT_EQ(run.stderrText.rfind("sslpv: error: " + f.strokes.string() + ": " + expected, 0), 0u)
+        << run.stderrText << "expected: " << expected;
+    EXPECT_EQ(std::count(run.stderrText.begin(), run.stderrText.end(), '\n'), 1) << run.stderrText;
+    EXPECT_EQ(readText(f.output), kPreexisting);
+    std::set<std::string> names;
+    for (const auto& entry : fs::directory_iterator(f.dir.path())) names.insert(entry.path().filename().string());
+    EXPECT_EQ(names, (std::set<std::string>{"scene.json", "strokes.json", "out.vdb"})) << "temporary files left";
+  }
+}
+
+TEST(PaintCli, BadOutputOrMissingStrokeFileExit2) {
+  Files f;
+  writeText(f.scene, sceneJson().dump());
+  RunResult run =
+      runSslpv({"paint", f.scene.string(), "--strokes", (f.dir / "none.json").string(), "-o", f.output.string()});
+  EXPECT_EQ(run.exitCode, 2);
+  EXPECT_NE(run.stderrText.find("none.json: cannot read stroke file"), std::string::npos) << run.stderrText;
+  writeText(f.strokes, R"({"strokes": []})");
+  run = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", (f.dir / "out.png").string()});
+  EXPECT_EQ(run.exitCode, 2);
+  EXPECT_NE(run.stderrText.find("must be a .vdb file"), std::string::npos) << run.stderrText;
+  EXPECT_FALSE(fs::exists(f.dir / "out.png"));
+}
+
+}  // namespace
+}  // namespace sslpv::test
