@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 
+#include "apps/cmd_bench_error.h"
 #include "apps/cmd_compare.h"
 #include "apps/cmd_paint.h"
 #include "apps/cmd_export.h"
@@ -196,6 +197,7 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
 
   // Subcommands from apps/cmd_*.cpp (each: Args struct, add<Name>Command, run<Name>).
+  sslpv::BenchErrorArgs benchError; CLI::App* benchErrorCmd = sslpv::addBenchErrorCommand(app, benchError);
   sslpv::PaintArgs paint; CLI::App* paintCmd = sslpv::addPaintCommand(app, paint);
   sslpv::ExportArgs exportArgs; CLI::App* exportCmd = sslpv::addExportCommand(app, exportArgs);
   sslpv::CompareArgs compare; CLI::App* compareCmd = sslpv::addCompareCommand(app, compare);
@@ -225,6 +227,7 @@ int main(int argc, char** argv) {
     if (*renderCmd) return runRender(render);
     if (*referenceCmd) return runReference(reference);
     // Dispatch of the apps/cmd_*.cpp subcommands.
+    if (*benchErrorCmd) return sslpv::runBenchError(benchError);
     if (*paintCmd) return sslpv::runPaint(paint);
     if (*exportCmd) return sslpv::runExport(exportArgs);
     if (*compareCmd) return sslpv::runCompare(compare);
