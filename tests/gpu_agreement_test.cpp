@@ -94,6 +94,17 @@ TEST_F(GpuAgreement, EveryShippedExample) {
   EXPECT_GE(compared, 4);
 }
 
+TEST_F(GpuAgreement, SeedSchemeToo) {
+  // The seed's coefficients keep the linear band and have no exit gain: a different path
+  // through the same kernels, which the calibrated default does not exercise.
+  for (const char* name : {"marble_pebble.json", "jade_slab_backlit.json"}) {
+    Scene scene = smaller(loadScene(test::examplesDir() / name));
+    scene.lpv.scheme = LpvScheme::Seed;
+    SCOPED_TRACE(name);
+    expectAgreement(scene);
+  }
+}
+
 /// A random closed primitive, homogeneous preset material, one or two random lights of
 /// each kind, a random camera looking at it.
 std::string randomScene(std::mt19937& rng) {
