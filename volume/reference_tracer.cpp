@@ -15,6 +15,7 @@
 
 #include "volume/error.h"
 #include "volume/fresnel.h"
+#include "volume/majorant_grid.h"
 #include "volume/ray_scene.h"
 #include "volume/scene_object.h"
 
@@ -95,6 +96,8 @@ struct ReferenceTracer::Impl {
   /// (scene units): offsetting the origin instead would skip a sliver of medium, a bias
   /// of epsilon / thickness in thin slabs.
   double epsilon = 1e-5;
+  MaterialSample base;  ///< the field outside every active voxel's reach
+  std::unique_ptr<MajorantGrid> majorants;
 
   struct LightSample {
     glm::dvec3 toLight{0.0};  ///< unit
@@ -123,11 +126,12 @@ struct ReferenceTracer::Impl {
     return s;
   }
 
-  /// Ratio tracking over the inside parts of origin + t*dir, t in [0, distance]. With
-  /// `fresnel`, each boundary crossing multiplies by the straight-line Fresnel
-  /// transmittance (the approximation stated in the header).
+  /// Residual ratio tracking over the inside parts of origin + t*dir, t in [0, distance],
+  /// brick by brick with each brick's minorant and majorant; homogeneous bricks contribute
+  /// exp(-σt·length) exactly. With `fresnel`, each boundary crossing multiplies by the straight-line
+  /// Fresnel transmittance (the approximation stated in the header).
   double transmittance(const MaterialField::Sampler& field, glm::dvec3 p, const glm::dvec3& dir, double distance,
-                       int c, ReferenceRng& rng, bool fresnel, double sigmaBar) const {
+                       int c, ReferenceRng& rng, bool fresnel) const {
     double tr = 1.0;
     double remaining = distance;
     for (int segment = 0; segment < kMaxSegments && tr > 0.0; ++segment) {
@@ -137,16 +141,26 @@ struct ReferenceTracer::Impl {
       const glm::dvec3 n(hit.normal);
       const double cosN = glm::dot(dir, n);
       const double length = double(hit.t);
-      if (cosN > 0.0 && sigmaBar > 0.0) {
-        double t = 0.0;
-        while (true) {
-          t -= std::log(1.0 - rng.uniform()) / sigmaBar;
-          if (t >= length) break;
-          const double sigmaT = channelOf(field.sample(p + t * dir).sigmaT, c);
-          tr *= std::max(0.0, 1.0 - sigmaT / sigmaBar);
-          if (tr < 0.1) {  // Russian roulette keeps the estimator unbiased and the loop short
-            if (rng.uniform() < 0.5) return 0.0;
-            tr *= 2.0;
+      if (cosN > 0.0) {
+        MajorantGrid::Walker walk(*majorants, p, dir, length);
+        MajorantGrid::Segment s;
+        while (tr > 0.0 && walk.next(s)) {
+          // Residual ratio tracking (Novák et al. 2014): the brick's minorant σc attenuates
+          // analytically, only σt - σc is tracked, with majorant σ̄ - σc. Homogeneous bricks
+          // have σc = σ̄ = σt: exact, no lookups.
+          const double control = s.brick->minorant[c];
+          const double residual = s.brick->majorant[c] - control;
+          tr *= std::exp(-control * (s.t1 - s.t0));
+          if (s.brick->homogeneous || !(residual > 0.0)) continue;
+          for (double t = s.t0;;) {
+            t -= std::log(1.0 - rng.uniform()) / residual;
+            if (t >= s.t1) break;
+            const double sigmaT = channelOf(field.sample(p + t * dir).sigmaT, c);
+            tr *= std::max(0.0, 1.0 - (sigmaT - control) / residual);
+            if (tr < 0.1) {  // Russian roulette keeps the estimator unbiased and the loop short
+              if (rng.uniform() < 0.5) return 0.0;
+              tr *= 2.0;
+            }
           }
         }
       }
@@ -159,7 +173,7 @@ struct ReferenceTracer::Impl {
   }
 
   double trace(const MaterialField::Sampler& field, glm::dvec3 p, glm::dvec3 d, int c, ReferenceRng& rng,
-               int maxScatterEvents, double sigmaBar) const {
+               int maxScatterEvents) const {
     double beta = 1.0;
     double radiance = 0.0;
     int scatters = 0;
@@ -170,36 +184,45 @@ struct ReferenceTracer::Impl {
       const double cosN = glm::dot(d, n);
       const double length = double(hit.t);
       bool scattered = false;
-      if (cosN > 0.0 && sigmaBar > 0.0) {
-        // Inside: delta tracking towards the boundary.
-        double t = 0.0;
-        while (true) {
-          t -= std::log(1.0 - rng.uniform()) / sigmaBar;
-          if (t >= length) break;
-          const glm::dvec3 x = p + t * d;
-          const MaterialSample m = field.sample(x);
-          const double sigmaT = channelOf(m.sigmaT, c);
-          if (rng.uniform() * sigmaBar >= sigmaT) continue;  // null collision
-          beta *= channelOf(m.sigmaS, c) / sigmaT;
-          for (const Light& light : scene.lights) {
-            const LightSample ls = sampleLight(light, x, c);
-            if (ls.value <= 0.0) continue;
-            const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true, sigmaBar);
-            radiance += beta * hgPhase(glm::dot(d, ls.toLight), double(m.g)) * ls.value * tr;
+      if (cosN > 0.0) {
+        // Inside: delta tracking towards the boundary, brick by brick. A free flight that
+        // passes a brick's far face restarts there with the next brick's majorant, which
+        // the exponential's lack of memory makes exact.
+        MajorantGrid::Walker walk(*majorants, p, d, length);
+        MajorantGrid::Segment s;
+        while (!scattered && walk.next(s)) {
+          const double sigmaBar = s.brick->majorant[c];
+          if (!(sigmaBar > 0.0)) continue;
+          for (double t = s.t0;;) {
+            t -= std::log(1.0 - rng.uniform()) / sigmaBar;
+            if (t >= s.t1) break;
+            const glm::dvec3 x = p + t * d;
+            // Homogeneous bricks hold the base material exactly, with majorant == σt: every
+            // tentative collision is real and no field lookup is needed.
+            const MaterialSample m = s.brick->homogeneous ? base : field.sample(x);
+            const double sigmaT = channelOf(m.sigmaT, c);
+            if (!s.brick->homogeneous && rng.uniform() * sigmaBar >= sigmaT) continue;  // null collision
+            beta *= channelOf(m.sigmaS, c) / sigmaT;
+            for (const Light& light : scene.lights) {
+              const LightSample ls = sampleLight(light, x, c);
+              if (ls.value <= 0.0) continue;
+              const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true);
+              radiance += beta * hgPhase(glm::dot(d, ls.toLight), double(m.g)) * ls.value * tr;
+            }
+            ++scatters;
+            if (maxScatterEvents > 0 && scatters >= maxScatterEvents) return radiance;
+            if (scatters > kRouletteStart) {
+              const double survive = std::min(1.0, beta);
+              if (!(rng.uniform() < survive)) return radiance;
+              beta /= survive;
+            }
+            if (beta <= 0.0) return radiance;
+            const double u1 = rng.uniform();
+            d = sampleHg(d, double(m.g), u1, rng.uniform());
+            p = x;
+            scattered = true;
+            break;
           }
-          ++scatters;
-          if (maxScatterEvents > 0 && scatters >= maxScatterEvents) return radiance;
-          if (scatters > kRouletteStart) {
-            const double survive = std::min(1.0, beta);
-            if (!(rng.uniform() < survive)) return radiance;
-            beta /= survive;
-          }
-          if (beta <= 0.0) return radiance;
-          const double u1 = rng.uniform();
-          d = sampleHg(d, double(m.g), u1, rng.uniform());
-          p = x;
-          scattered = true;
-          break;
         }
       }
       if (scattered) continue;
@@ -230,32 +253,30 @@ struct ReferenceTracer::Impl {
   }
 };
 
-ReferenceTracer::ReferenceTracer(const Scene& scene)
-    : ReferenceTracer(scene, scene.material.vdb ? loadMaterialSet(*scene.material.vdb) : nullptr) {}
+ReferenceTracer::ReferenceTracer(const Scene& scene, const MajorantGridOptions& majorants)
+    : ReferenceTracer(scene, scene.material.vdb ? loadMaterialSet(*scene.material.vdb) : nullptr, majorants) {}
 
-ReferenceTracer::ReferenceTracer(const Scene& scene, std::shared_ptr<const MaterialSet> set)
+ReferenceTracer::ReferenceTracer(const Scene& scene, std::shared_ptr<const MaterialSet> set,
+                                 const MajorantGridOptions& majorants)
     : impl_(std::make_unique<Impl>()) {
   impl_->scene = scene;
   // The set is given here, so SceneObject must not load it again.
   Scene withoutVdb = scene;
   withoutVdb.material.vdb.reset();
   impl_->object = std::make_unique<SceneObject>(withoutVdb);
-  glm::dvec3 majorant(scene.material.base.sigmaT);
+  double sigmaScale = 1.0;
   if (set) {
     const auto fileUnit = unitInMm(set->units);
     if (!fileUnit)
       throw InputError((scene.material.vdb ? scene.material.vdb->string() : std::string("material set")) +
                        ": unknown units '" + set->units + "' in file metadata (expected mm, cm, m or in)");
-    const double sigmaScale = scene.unitInMm / *fileUnit;  // as SceneObject::setMaterialSet
-    // Trilinear weights are convex and inactive voxels read the base, so the field never
-    // exceeds max(active values, base): a global majorant.
-    for (auto it = set->sigmaT->cbeginValueOn(); it; ++it) {
-      const openvdb::Vec3s v = *it;
-      for (int c = 0; c < 3; ++c) majorant[c] = std::max(majorant[c], double(v[c]) * sigmaScale);
-    }
+    sigmaScale = scene.unitInMm / *fileUnit;  // as SceneObject::setMaterialSet
     impl_->object->setMaterialSet(set);
   }
-  majorant_ = majorant;
+  impl_->base = impl_->object->field().base();
+  impl_->majorants = std::make_unique<MajorantGrid>(impl_->object->bounds(), impl_->base, set.get(),
+                                                    scene.transform.matrix(), sigmaScale, majorants);
+  majorant_ = impl_->majorants->globalMajorant();
   impl_->rays = std::make_unique<RayScene>(impl_->object->mesh());
   impl_->eta = scene.material.ior;
   const Bounds& b = impl_->object->bounds();
@@ -269,15 +290,19 @@ ReferenceTracer::~ReferenceTracer() = default;
 double ReferenceTracer::radianceSample(const glm::dvec3& origin, const glm::dvec3& dir, int channel,
                                        ReferenceRng& rng, int maxScatterEvents) const {
   const MaterialField::Sampler field = impl_->object->field().sampler();
-  return impl_->trace(field, origin, dir, channel, rng, maxScatterEvents, majorant_[channel]);
+  return impl_->trace(field, origin, dir, channel, rng, maxScatterEvents);
 }
+
+const MajorantGrid& ReferenceTracer::majorantGrid() const { return *impl_->majorants; }
+
+const MaterialField& ReferenceTracer::field() const { return impl_->object->field(); }
 
 double ReferenceTracer::estimateTransmittance(const glm::dvec3& a, const glm::dvec3& b, int channel,
                                               ReferenceRng& rng) const {
   const MaterialField::Sampler field = impl_->object->field().sampler();
   const double distance = glm::length(b - a);
   if (!(distance > 0.0)) return 1.0;
-  return impl_->transmittance(field, a, (b - a) / distance, distance, channel, rng, false, majorant_[channel]);
+  return impl_->transmittance(field, a, (b - a) / distance, distance, channel, rng, false);
 }
 
 ReferenceResult ReferenceTracer::render(const ReferenceOptions& options) const {
@@ -313,8 +338,7 @@ ReferenceResult ReferenceTracer::render(const ReferenceOptions& options) const {
               for (int s = 0; s < options.spp; ++s) {
                 ReferenceRng rng(options.seed, pixel, std::uint64_t(s));
                 for (int c = 0; c < 3; ++c) {
-                  const double l = impl_->trace(field, camera.position, dir, c, rng, options.maxScatterEvents,
-                                                majorant_[c]);
+                  const double l = impl_->trace(field, camera.position, dir, c, rng, options.maxScatterEvents);
                   sum[c] += l;
                   sumSq[c] += l * l;
                 }

@@ -1,9 +1,12 @@
 #pragma once
 // Ground truth for SSLPV: a Monte Carlo volumetric path tracer over exactly the scene
-// `sslpv render` reads (issue 4). Delta tracking with one global majorant per channel
-// (max σt over the material field), Henyey–Greenstein phase with the local g, RGB traced
-// one channel at a time, a smooth dielectric boundary (ior 1 = invisible boundary) and
-// next-event estimation to point, spot and directional lights.
+// `sslpv render` reads (issue 4). Delta tracking (free flights) and residual ratio
+// tracking (shadow rays) with a majorant and a minorant per brick and channel
+// (volume/majorant_grid.h), exact exp(-σt·length) and no field lookups in bricks the
+// material set does not reach, Henyey–Greenstein phase
+// with the local g, RGB traced one channel at a time, a smooth dielectric boundary
+// (ior 1 = invisible boundary) and next-event estimation to point, spot and directional
+// lights.
 //
 // Approximation (ior != 1 only): lights are delta lights outside the object, so a path
 // vertex inside can reach them only through the refracting boundary, and that connection
@@ -22,6 +25,7 @@
 #include <memory>
 
 #include "volume/image_io.h"
+#include "volume/majorant_grid.h"
 #include "volume/material_set.h"
 #include "volume/scene.h"
 
@@ -62,9 +66,10 @@ struct ReferenceResult {
 class ReferenceTracer {
  public:
   /// Loads the object (and its material set when the scene names one). InputError on bad input.
-  explicit ReferenceTracer(const Scene& scene);
+  explicit ReferenceTracer(const Scene& scene, const MajorantGridOptions& majorants = {});
   /// Uses `set` (in the scene's material.vdb units; nullptr: base only) instead of loading.
-  ReferenceTracer(const Scene& scene, std::shared_ptr<const MaterialSet> set);
+  ReferenceTracer(const Scene& scene, std::shared_ptr<const MaterialSet> set,
+                  const MajorantGridOptions& majorants = {});
   ~ReferenceTracer();
   ReferenceTracer(const ReferenceTracer&) = delete;
   ReferenceTracer& operator=(const ReferenceTracer&) = delete;
@@ -81,8 +86,12 @@ class ReferenceTracer {
   /// are not counted).
   double estimateTransmittance(const glm::dvec3& a, const glm::dvec3& b, int channel, ReferenceRng& rng) const;
 
-  /// The per-channel majorant: max σt over the set's active values and the base.
+  /// The global per-channel majorant: max σt over the set's active values and the base.
   glm::dvec3 majorant() const { return majorant_; }
+  /// The per-brick majorants the trackers use.
+  const MajorantGrid& majorantGrid() const;
+  /// The material field the tracer samples (for checks against the majorants).
+  const MaterialField& field() const;
 
  private:
   struct Impl;
