@@ -23,6 +23,7 @@
 #include "volume/lpv_calibration.h"
 #include "volume/material.h"
 #include "volume/reference_tracer.h"
+#include "volume/slab_reflectance.h"
 #include "volume/scene.h"
 
 namespace {
@@ -107,7 +108,7 @@ int main(int argc, char** argv) {
     const glm::dvec3 seed = meanReflectance(CpuRenderer(scene).render(settings));
     for (int ch = 0; ch < 3; ++ch) {
       const double sPrime = material.sigmaSPrime[ch], sA = material.sigmaA[ch];
-      const double dipole = dipoleReflectance(sPrime / (sPrime + sA), ior);
+      const double dipole = dipoleRd(sPrime / (sPrime + sA), ior);
       const double calErr = calibrated[ch] / reference[ch] - 1.0;
       worst = std::max(worst, std::abs(calErr));
       std::printf("%-9s %2c %5.2f %9.5f±%.5f %7.4f %7.4f %+7.1f%% %7.4f %+7.1f%%\n", std::string(material.name).c_str(),

@@ -22,70 +22,21 @@
 
 #include "volume/lpv_constants.h"
 #include "volume/lpv_stages.h"
+#include "volume/slab_reflectance.h"
 
 namespace sslpv {
 namespace {
 
-/// Nodes and weights of n-point Gauss-Legendre quadrature on [0, 1].
-void gaussLegendre01(int n, std::vector<double>& nodes, std::vector<double>& weights) {
-  nodes.resize(n);
-  weights.resize(n);
-  for (int i = 0; i < n; ++i) {
-    double x = std::cos(SSLPV_PI * (i + 0.75) / (n + 0.5));
-    double derivative = 1.0;
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      double p0 = 1.0, p1 = x;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      derivative = n * (x * p1 - p0) / (x * x - 1.0);
-      const double dx = p1 / derivative;
-      x -= dx;
-      if (std::abs(dx) < 1e-15) break;
-    }
-    nodes[i] = 0.5 * (x + 1.0);
-    weights[i] = 1.0 / ((1.0 - x * x) * derivative * derivative);  // 2/(...) halved for [0,1]
-  }
-}
-
-/// H(1) for isotropic scattering of albedo `albedo`, by iterating
-/// 1/H(μ) = sqrt(1 - α) + (α/2) ∫0^1 μ' H(μ') / (μ + μ') dμ'.
-double chandrasekharH1(double albedo, const std::vector<double>& mu, const std::vector<double>& w) {
-  const std::size_t n = mu.size();
-  std::vector<double> h(n, 1.0), next(n);
-  const double root = std::sqrt(std::max(0.0, 1.0 - albedo));
-  auto evaluate = [&](double at) {
-    double integral = 0.0;
-    for (std::size_t j = 0; j < n; ++j) integral += w[j] * mu[j] * h[j] / (at + mu[j]);
-    return 1.0 / (root + 0.5 * albedo * integral);
-  };
-  for (int iteration = 0; iteration < 2000; ++iteration) {
-    double change = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      next[i] = evaluate(mu[i]);
-      change = std::max(change, std::abs(next[i] - h[i]));
-    }
-    h.swap(next);
-    if (change < 1e-12) break;
-  }
-  return evaluate(1.0);
-}
-
-constexpr int kReflectanceTable = 512;  // entries over t = sqrt(1 - albedo) in [0, 1]
+constexpr int kReflectanceTable = 128;  // entries over t = sqrt(1 - albedo) in [0, 1]
 
 const std::vector<double>& reflectanceTable() {
   static std::vector<double> table;
   static std::once_flag once;
   std::call_once(once, [] {
-    std::vector<double> mu, w;
-    gaussLegendre01(48, mu, w);
     table.resize(kReflectanceTable + 1);
     for (int i = 0; i <= kReflectanceTable; ++i) {
       const double t = double(i) / kReflectanceTable;
-      const double albedo = 1.0 - t * t;
-      table[i] = 1.0 - chandrasekharH1(albedo, mu, w) * t;
+      table[i] = exactIsotropicRd(1.0 - t * t);
     }
   });
   return table;
@@ -113,13 +64,6 @@ double halfSpaceReflectance(double albedo) {
   const int i = std::min(int(t), kReflectanceTable - 1);
   const double f = t - i;
   return (1.0 - f) * table[i] + f * table[i + 1];
-}
-
-double dipoleReflectance(double reducedAlbedo, double eta) {
-  const double fdr = -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta;
-  const double a = (1.0 + fdr) / (1.0 - fdr);
-  const double root = std::sqrt(3.0 * std::max(0.0, 1.0 - reducedAlbedo));
-  return 0.5 * reducedAlbedo * (1.0 + std::exp(-(4.0 / 3.0) * a * root)) * std::exp(-root);
 }
 
 std::array<double, 3> injectedLobeSplit() {
@@ -152,7 +96,7 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   const double latticeReflectance = 3.0 * r * (split[1] + r * split[2]);
   const double reducedAlbedo = reducedT > 0.0 ? reducedS / reducedT : 1.0;
   const double target = halfSpaceReflectance(reducedAlbedo) *
-                        (dipoleReflectance(reducedAlbedo, ior) / dipoleReflectance(reducedAlbedo, 1.0));
+                        (dipoleRd(reducedAlbedo, ior) / dipoleRd(reducedAlbedo, 1.0));
   double gain = latticeReflectance > 0.0 ? ior * ior * target / latticeReflectance : 0.0;
   if (!std::isfinite(gain) || reducedAlbedo <= 0.0) gain = 0.0;
   return {float(survival), 0.0f, float(gain)};

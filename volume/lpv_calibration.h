@@ -55,14 +55,9 @@ CellTransport seedTransport(double sigmaT, double sigmaS, double g, double cellS
 /// The calibrated factors for a cell of the given material, cell size and boundary index.
 CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double cellSize, double ior);
 
-/// Exact total diffuse reflectance of a semi-infinite, index-matched medium with
-/// isotropic scattering of albedo `albedo` under normal collimated illumination:
-/// 1 - H(1)·sqrt(1 - albedo). Tabulated once (H by fixed-point iteration on 48
-/// Gauss-Legendre nodes), interpolated in sqrt(1 - albedo); error < 1e-4.
+/// exactIsotropicRd (volume/slab_reflectance.h), 1 - H(1)·sqrt(1 - albedo), tabulated
+/// once over sqrt(1 - albedo) and interpolated: every cell of every grid needs it.
 double halfSpaceReflectance(double albedo);
-
-/// Jensen et al. 2001 dipole total diffuse reflectance for reduced albedo and index η.
-double dipoleReflectance(double reducedAlbedo, double eta);
 
 /// Fractions of an injected cosine lobe's power that the first propagation step sends
 /// (back out of the layer, within the layer, one layer deeper), from the same clamped
