@@ -131,12 +131,13 @@ struct ReferenceTracer::Impl {
   /// exp(-σt·length) exactly. With `fresnel`, each boundary crossing multiplies by the straight-line
   /// Fresnel transmittance (the approximation stated in the header).
   double transmittance(const MaterialField::Sampler& field, glm::dvec3 p, const glm::dvec3& dir, double distance,
-                       int c, ReferenceRng& rng, bool fresnel) const {
+                       int c, ReferenceRng& rng, bool fresnel, bool fromVolume) const {
     double tr = 1.0;
     double remaining = distance;
     for (int segment = 0; segment < kMaxSegments && tr > 0.0; ++segment) {
       const float tFar = std::isfinite(remaining) ? float(remaining) : 3.0e38f;
-      const RayHit hit = rays->intersect(glm::vec3(p), glm::vec3(dir), float(epsilon), tFar);
+      const float tNear = segment == 0 && fromVolume ? 0.0f : float(epsilon);
+      const RayHit hit = rays->intersect(glm::vec3(p), glm::vec3(dir), tNear, tFar);
       if (!hit.hit) break;  // no more boundary before the end point: outside, nothing attenuates
       const glm::dvec3 n(hit.normal);
       const double cosN = glm::dot(dir, n);
@@ -177,8 +178,14 @@ struct ReferenceTracer::Impl {
     double beta = 1.0;
     double radiance = 0.0;
     int scatters = 0;
+    // Only rays that leave a surface point skip hits closer than epsilon. From a scattering
+    // vertex the boundary may be closer than that, and skipping it would let a path that
+    // should be reflected back (ior != 1) escape instead: a bias of about -σt·epsilon·F
+    // per approach of the boundary, measured at -0.4 % of Rd in a 1300-mean-free-path slab.
+    bool fromVolume = false;
     for (int segment = 0; segment < kMaxSegments; ++segment) {
-      const RayHit hit = rays->intersect(glm::vec3(p), glm::vec3(d), float(epsilon));
+      const RayHit hit = rays->intersect(glm::vec3(p), glm::vec3(d), fromVolume ? 0.0f : float(epsilon));
+      fromVolume = false;
       if (!hit.hit) return radiance;  // background 0 (or a leak out of the mesh)
       const glm::dvec3 n(hit.normal);
       const double cosN = glm::dot(d, n);
@@ -206,7 +213,7 @@ struct ReferenceTracer::Impl {
             for (const Light& light : scene.lights) {
               const LightSample ls = sampleLight(light, x, c);
               if (ls.value <= 0.0) continue;
-              const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true);
+              const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true, true);
               radiance += beta * hgPhase(glm::dot(d, ls.toLight), double(m.g)) * ls.value * tr;
             }
             ++scatters;
@@ -220,6 +227,7 @@ struct ReferenceTracer::Impl {
             const double u1 = rng.uniform();
             d = sampleHg(d, double(m.g), u1, rng.uniform());
             p = x;
+            fromVolume = true;
             scattered = true;
             break;
           }
@@ -302,7 +310,7 @@ double ReferenceTracer::estimateTransmittance(const glm::dvec3& a, const glm::dv
   const MaterialField::Sampler field = impl_->object->field().sampler();
   const double distance = glm::length(b - a);
   if (!(distance > 0.0)) return 1.0;
-  return impl_->transmittance(field, a, (b - a) / distance, distance, channel, rng, false);
+  return impl_->transmittance(field, a, (b - a) / distance, distance, channel, rng, false, false);
 }
 
 ReferenceResult ReferenceTracer::render(const ReferenceOptions& options) const {
