@@ -525,4 +525,39 @@ Scene loadScene(const fs::path& file) {
   return parseScene(text, file);
 }
 
+LpvSettings applyLpvFlags(LpvSettings settings, const LpvFlags& flags) {
+  if (flags.grid) {
+    if (*flags.grid < 2 || *flags.grid > kMaxLpvResolution)
+      throw InputError("--grid: must be between 2 and " + std::to_string(kMaxLpvResolution) + ", got " +
+                       std::to_string(*flags.grid));
+    settings.resolution = *flags.grid;
+  }
+  if (!flags.steps.empty()) {
+    if (flags.steps == "auto") {
+      settings.autoSteps = true;
+    } else {
+      std::size_t used = 0;
+      int steps = -1;
+      try {
+        steps = std::stoi(flags.steps, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != flags.steps.size() || steps < 1 || steps > kMaxSteps)
+        throw InputError("--steps: expected 'auto' or a whole number from 1 to " + std::to_string(kMaxSteps) +
+                         ", got '" + flags.steps + "'");
+      settings.steps = steps;
+      settings.autoSteps = false;
+    }
+  }
+  if (flags.shadowMap) {
+    if (*flags.shadowMap < 1 || *flags.shadowMap > kMaxShadowMap)
+      throw InputError("--shadow-map: must be between 1 and " + std::to_string(kMaxShadowMap));
+    settings.shadowMap = *flags.shadowMap;
+  }
+  if (!flags.scheme.empty() && !parseLpvScheme(flags.scheme, settings.scheme))
+    throw InputError("--scheme: unknown scheme '" + flags.scheme + "' (calibrated, seed)");
+  return settings;
+}
+
 }  // namespace sslpv

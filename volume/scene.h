@@ -89,6 +89,17 @@ inline constexpr int kMaxShadowMap = 8192;
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr int kMaxSteps = 1000000;
 
+/// Command-line overrides of a scene's lpv settings (`render`, `edit`); empty = keep.
+struct LpvFlags {
+  std::optional<int> grid;    ///< --grid
+  std::string steps;          ///< --steps: a whole number or "auto"
+  std::optional<int> shadowMap;  ///< --shadow-map
+  std::string scheme;         ///< --scheme: calibrated | seed
+};
+
+/// `settings` with the flags applied. InputError naming the flag on a bad value.
+LpvSettings applyLpvFlags(LpvSettings settings, const LpvFlags& flags);
+
 /// Reads and validates a scene file. Throws InputError (file and key path in the message).
 Scene loadScene(const std::filesystem::path& file);
 
