@@ -264,13 +264,7 @@ Image readExr(const fs::path& file) {
 // ---- PNG: display-referred 8-bit sRGB.
 
 void writePng(const Image& image, const fs::path& path, const fs::path& target, float exposure) {
-  std::vector<unsigned char> bytes(image.pixels.size() * 3);
-  for (std::size_t i = 0; i < image.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      float v = image.pixels[i][c] * exposure;
-      v = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
-      bytes[i * 3 + c] = static_cast<unsigned char>(std::lround(linearToSrgb(v) * 255.0f));
-    }
+  const std::vector<unsigned char> bytes = toDisplayRgb8(image, exposure);
   // Encode to memory and write it ourselves: stbi_write_png ignores fwrite errors, so a
   // full disk would go unnoticed and a truncated PNG would be renamed over the target.
   std::string encoded;
@@ -303,6 +297,17 @@ Image readPng(const fs::path& file) {
 }
 
 }  // namespace
+
+std::vector<unsigned char> toDisplayRgb8(const Image& image, float exposure) {
+  std::vector<unsigned char> bytes(image.pixels.size() * 3);
+  for (std::size_t i = 0; i < image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      float v = image.pixels[i][c] * exposure;
+      v = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
+      bytes[i * 3 + c] = static_cast<unsigned char>(std::lround(linearToSrgb(v) * 255.0f));
+    }
+  return bytes;
+}
 
 bool isSupportedImageExtension(const fs::path& file) {
   return formatOf(file) != ImageFormat::Unknown;

@@ -21,6 +21,10 @@ struct Image {
 /// other extension or a missing/unwritable directory; the target is never half-written.
 void writeImage(const Image& image, const std::filesystem::path& file, float exposure = 1.0f);
 
+/// The PNG writer's display encoding (exposure, clamp to [0, 1], sRGB, 8 bits), RGB
+/// interleaved, row 0 the top row: what a window shows of a rendered image.
+std::vector<unsigned char> toDisplayRgb8(const Image& image, float exposure = 1.0f);
+
 /// Reads .pfm or .exr (linear) or .png (converted back to linear). InputError when
 /// unreadable, truncated or of another format.
 Image readImage(const std::filesystem::path& file);
