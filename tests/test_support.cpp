@@ -48,22 +48,21 @@ std::string readText(const fs::path& file) {
   return s.str();
 }
 
-RunResult runSslpv(const std::vector<std::string>& args) {
+RunResult runProgram(const std::vector<std::string>& command) {
   TempDir capture;
   fs::path outFile = capture / "stdout", errFile = capture / "stderr";
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 1, outFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::vector<std::string> argvStorage{SSLPV_BINARY};
-  argvStorage.insert(argvStorage.end(), args.begin(), args.end());
+  std::vector<std::string> argvStorage = command;
   std::vector<char*> argv;
   for (auto& a : argvStorage) argv.push_back(a.data());
   argv.push_back(nullptr);
   pid_t pid = 0;
-  int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw std::runtime_error(std::string("cannot start ") + SSLPV_BINARY);
+  if (rc != 0) throw std::runtime_error("cannot start " + command.front());
   int status = 0;
   waitpid(pid, &status, 0);
   RunResult result;
@@ -72,6 +71,12 @@ RunResult runSslpv(const std::vector<std::string>& args) {
   result.stdoutText = readText(outFile);
   result.stderrText = readText(errFile);
   return result;
+}
+
+RunResult runSslpv(const std::vector<std::string>& args) {
+  std::vector<std::string> command{SSLPV_BINARY};
+  command.insert(command.end(), args.begin(), args.end());
+  return runProgram(command);
 }
 
 fs::path sourceDir() { return SSLPV_SOURCE_DIR; }

@@ -31,6 +31,9 @@ struct RunResult {
   std::string stderrText;
 };
 
+/// Runs `command` (argv[0] searched in PATH, no shell), capturing its output.
+RunResult runProgram(const std::vector<std::string>& command);
+
 /// Runs the built sslpv binary with `args` (no shell), capturing its output.
 RunResult runSslpv(const std::vector<std::string>& args);
 
