@@ -18,6 +18,7 @@
 #include "apps/cmd_compare.h"
 #include "apps/cmd_paint.h"
 #include "apps/cmd_export.h"
+#include "apps/cmd_edit.h"
 #ifdef SSLPV_HAVE_VULKAN
 #include "gpu/device.h"
 #include "gpu/vk_check.h"
@@ -60,38 +61,7 @@ int runRender(const RenderArgs& args) {
   requireWritableOutput(args.output);
 
   Scene scene = loadScene(args.scene);
-  LpvSettings settings = scene.lpv;
-  if (args.grid) {
-    if (*args.grid < 2 || *args.grid > kMaxLpvResolution)
-      throw InputError("--grid: must be between 2 and " + std::to_string(kMaxLpvResolution) + ", got " +
-                       std::to_string(*args.grid));
-    settings.resolution = *args.grid;
-  }
-  if (!args.steps.empty()) {
-    if (args.steps == "auto") {
-      settings.autoSteps = true;
-    } else {
-      std::size_t used = 0;
-      int steps = -1;
-      try {
-        steps = std::stoi(args.steps, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != args.steps.size() || steps < 1 || steps > kMaxSteps)
-        throw InputError("--steps: expected 'auto' or a whole number from 1 to " + std::to_string(kMaxSteps) +
-                         ", got '" + args.steps + "'");
-      settings.steps = steps;
-      settings.autoSteps = false;
-    }
-  }
-  if (args.shadowMap) {
-    if (*args.shadowMap < 1 || *args.shadowMap > kMaxShadowMap)
-      throw InputError("--shadow-map: must be between 1 and " + std::to_string(kMaxShadowMap));
-    settings.shadowMap = *args.shadowMap;
-  }
-  if (!args.scheme.empty() && !parseLpvScheme(args.scheme, settings.scheme))
-    throw InputError("--scheme: unknown scheme '" + args.scheme + "' (calibrated, seed)");
+  const LpvSettings settings = applyLpvFlags(scene.lpv, {args.grid, args.steps, args.shadowMap, args.scheme});
   if (!(args.exposure > 0.0f)) throw InputError("--exposure: must be positive");
 
   RenderReport report;
@@ -197,10 +167,16 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
 
   // Subcommands from apps/cmd_*.cpp (each: Args struct, add<Name>Command, run<Name>).
-  sslpv::BenchErrorArgs benchError; CLI::App* benchErrorCmd = sslpv::addBenchErrorCommand(app, benchError);
-  sslpv::PaintArgs paint; CLI::App* paintCmd = sslpv::addPaintCommand(app, paint);
-  sslpv::ExportArgs exportArgs; CLI::App* exportCmd = sslpv::addExportCommand(app, exportArgs);
-  sslpv::CompareArgs compare; CLI::App* compareCmd = sslpv::addCompareCommand(app, compare);
+  sslpv::EditArgs edit;
+  CLI::App* editCmd = sslpv::addEditCommand(app, edit);
+  sslpv::BenchErrorArgs benchError;
+  CLI::App* benchErrorCmd = sslpv::addBenchErrorCommand(app, benchError);
+  sslpv::PaintArgs paint;
+  CLI::App* paintCmd = sslpv::addPaintCommand(app, paint);
+  sslpv::ExportArgs exportArgs;
+  CLI::App* exportCmd = sslpv::addExportCommand(app, exportArgs);
+  sslpv::CompareArgs compare;
+  CLI::App* compareCmd = sslpv::addCompareCommand(app, compare);
 
   // CLI11 reports a stray subcommand only as "extra arguments"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {
@@ -227,6 +203,7 @@ int main(int argc, char** argv) {
     if (*renderCmd) return runRender(render);
     if (*referenceCmd) return runReference(reference);
     // Dispatch of the apps/cmd_*.cpp subcommands.
+    if (*editCmd) return sslpv::runEdit(edit);
     if (*benchErrorCmd) return sslpv::runBenchError(benchError);
     if (*paintCmd) return sslpv::runPaint(paint);
     if (*exportCmd) return sslpv::runExport(exportArgs);
