@@ -5,6 +5,7 @@
 
 #include "lpv_test_grids.h"
 #include "volume/error.h"
+#include "volume/lpv_calibration.h"
 #include "volume/mesh.h"
 #include "volume/sh.h"
 
@@ -187,6 +188,41 @@ TEST(GridFrame, TooLargeAGridIsAClearResourceError) {
   EXPECT_EQ(f.dims, glm::ivec3(32));
   // One margin cell on each side of the object.
   EXPECT_NEAR(f.origin.x, -f.cellSize, 1e-12);
+}
+
+TEST(ExitGain, HomogeneousCellsKeepTheirCalibratedGain) {
+  // Inside a homogeneous medium every neighbour has the same gain, so the neighbourhood
+  // limit changes nothing: the calibration (and its tests) stay exact.
+  const MaterialGrid m = test::uniformMaterial(6, glm::vec3(3.0f, 5.0f, 9.0f), glm::vec3(1.0f, 1.0f, 1.0f), 0.2f, 0.7);
+  const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.3);
+  for (int ch = 0; ch < 3; ++ch) {
+    const float own = calibratedTransport(m.sigmaT[0][ch], m.sigmaS[0][ch], m.g[0], 0.7, 1.3).exitGain;
+    for (std::size_t i = 0; i < f.exitGain[ch].size(); ++i) {
+      if (!f.active[i]) continue;
+      ASSERT_EQ(f.exitGain[ch][i], own) << "cell " << i << " channel " << ch;
+    }
+  }
+}
+
+TEST(ExitGain, AnAbsorbingCellInABrightMediumTakesItsNeighboursGain) {
+  // A painted dark spot (σt x4, σs unchanged: albedo 0.2) in marble-like medium (albedo
+  // 0.95): its own gain is far larger (it corrects light injected in that cell, which the
+  // lattice holds too shallow), but most of the light it holds diffused in from the bright
+  // neighbours; with its own gain that light would glow. It takes the smallest gain among
+  // itself and its face neighbours; the neighbours keep their own (smaller) gain.
+  MaterialGrid m = test::uniformMaterial(7, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
+  const std::size_t spot = m.frame.index(3, 3, 3);
+  m.sigmaT[spot] = glm::vec3(8.0f);
+  const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.0);
+  const float bright = calibratedTransport(2.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
+  const float dark = calibratedTransport(8.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
+  ASSERT_GT(dark, 2.0f * bright) << "the premise: an absorbing cell's own gain is much larger";
+  EXPECT_EQ(f.exitGain[0][spot], bright);
+  EXPECT_EQ(f.exitGain[0][m.frame.index(4, 3, 3)], bright);
+  EXPECT_EQ(f.exitGain[0][m.frame.index(1, 1, 1)], bright);
+  // The seed scheme has no gain at all.
+  const StepFactors seed = computeStepFactors(m, LpvScheme::Seed, 1.0);
+  EXPECT_EQ(seed.exitGain[0][spot], 1.0f);
 }
 
 }  // namespace

@@ -186,6 +186,38 @@ glm::dvec3 gridPower(const ShGrid& grid) {
   return power;
 }
 
+// The calibrated exit gain maps a homogeneous medium's lattice reflectance to the true
+// one; it grows like 1/r (r = exp(-σtr Δx)) as a cell gets more absorbing, because there
+// the lattice's first cell holds far less light than the medium's first transport length.
+// That holds for light injected in the cell itself. A strongly absorbing cell painted into
+// a bright medium also receives light diffusing in from its neighbours, and its large gain
+// would turn that into a glow where the artist painted a dark spot. Each cell therefore
+// uses the smallest gain of itself and its active face neighbours: unchanged inside any
+// homogeneous region (all gains equal), the neighbours' gain at a material boundary.
+void limitExitGainToNeighbours(const MaterialGrid& material, StepFactors& factors) {
+  const GridFrame& f = material.frame;
+  for (int ch = 0; ch < 3; ++ch) {
+    const std::vector<float> own = factors.exitGain[ch];
+    std::vector<float>& gain = factors.exitGain[ch];
+    tbb::parallel_for(0, f.dims.z, [&](int z) {
+      for (int y = 0; y < f.dims.y; ++y)
+        for (int x = 0; x < f.dims.x; ++x) {
+          const std::size_t i = f.index(x, y, z);
+          if (!factors.active[i]) continue;
+          float smallest = own[i];
+          const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+          for (const auto& o : offsets) {
+            const int nx = x + o[0], ny = y + o[1], nz = z + o[2];
+            if (nx < 0 || ny < 0 || nz < 0 || nx >= f.dims.x || ny >= f.dims.y || nz >= f.dims.z) continue;
+            const std::size_t j = f.index(nx, ny, nz);
+            if (factors.active[j]) smallest = std::min(smallest, own[j]);
+          }
+          gain[i] = smallest;
+        }
+    });
+  }
+}
+
 }  // namespace
 
 StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, double ior) {
@@ -219,6 +251,7 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
         }
       }
   });
+  if (scheme == LpvScheme::Calibrated) limitExitGainToNeighbours(material, factors);
   return factors;
 }
 
