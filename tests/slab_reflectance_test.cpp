@@ -9,6 +9,7 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "half_space_walk.h"
 #include "volume/fresnel.h"
 #include "volume/reference_tracer.h"
 #include "volume/slab_reflectance.h"
@@ -80,39 +81,6 @@ TEST(SlabReflectance, IndexMatchedSlabMatchesExactHalfSpaceAndDipole) {
     }
   }
   std::cout << r.seconds << " s\n";
-}
-
-/// Reflected fraction of a collimated normal beam on an isotropically scattering
-/// half-space (σt = 1) with a smooth boundary of relative index eta: an analog random
-/// walk in depth and direction cosine only, with nothing in common with the tracer but
-/// fresnelReflectance. Specular reflection at entry is not counted.
-double halfSpaceWalk(double albedo, double eta, int photons, std::uint64_t seed, double& standardError) {
-  ReferenceRng rng(seed, 0, 0);
-  const double f0 = fresnelReflectance(1.0, eta);
-  int reflected = 0;
-  for (int k = 0; k < photons; ++k) {
-    if (rng.uniform() < f0) continue;
-    double z = 0.0, mu = 1.0;  // depth, and direction cosine with +z pointing down
-    while (true) {
-      z -= std::log(1.0 - rng.uniform()) * mu;
-      if (z < 0.0) {
-        const double sin2T = eta * eta * (1.0 - mu * mu);
-        const double reflect = sin2T >= 1.0 ? 1.0 : fresnelReflectance(std::sqrt(1.0 - sin2T), eta);
-        if (rng.uniform() < reflect) {  // mirrored back in; the flight restarts at the face
-          z = 0.0;
-          mu = -mu;
-          continue;
-        }
-        ++reflected;
-        break;
-      }
-      if (rng.uniform() >= albedo) break;
-      mu = 1.0 - 2.0 * rng.uniform();
-    }
-  }
-  const double p = double(reflected) / photons;
-  standardError = std::sqrt(p * (1.0 - p) / photons);
-  return p;
 }
 
 // With η = 1.3 the tracer's straight-line light connection is exact for this slab (the

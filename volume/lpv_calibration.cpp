@@ -13,33 +13,72 @@
 //  - the injected lobe itself integrates to zero over the outward hemisphere, and the
 //    shading turns an isotropic cell of power P into radiance P / (2 π Δx²); with
 //    irradiance E the injected power per cell is E Δx², so π L / E = w(1) / 2.
+//  - with a boundary of relative index η the injection has already multiplied E by
+//    1 - F(0) and the shading multiplies the radiance by (1 - F(θ)) / η², so the power the
+//    lattice reflects is exitGain · R_lpv · (1 - F(0)) · T, T = 2 ∫ (1 - F(θ)) cos θ dcos θ / η²
+//    over the outside hemisphere (diffuseBoundaryTransmittance: the share of an isotropic
+//    field inside that crosses the boundary).
 #include "volume/lpv_calibration.h"
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <vector>
 
+#include "volume/adding_doubling.h"
+#include "volume/fresnel.h"
 #include "volume/lpv_constants.h"
 #include "volume/lpv_stages.h"
-#include "volume/slab_reflectance.h"
 
 namespace sslpv {
 namespace {
 
-constexpr int kReflectanceTable = 128;  // entries over t = sqrt(1 - albedo) in [0, 1]
+constexpr int kReflectanceTable = 128;  // intervals over t = sqrt(1 - albedo) in [0, 1]
 
-const std::vector<double>& reflectanceTable() {
-  static std::vector<double> table;
-  static std::once_flag once;
-  std::call_once(once, [] {
-    table.resize(kReflectanceTable + 1);
-    for (int i = 0; i <= kReflectanceTable; ++i) {
-      const double t = double(i) / kReflectanceTable;
-      table[i] = exactIsotropicRd(1.0 - t * t);
-    }
-  });
+/// boundaryReflectance for one ior: Rd / albedo at t = i / kReflectanceTable. Dividing by
+/// the albedo keeps the relative interpolation error small at low albedo, where Rd -> 0 as
+/// fast as the albedo (single scattering).
+struct BoundaryTable {
+  double ior = 1.0;
+  std::vector<double> rdOverAlbedo;
+  double entering = 1.0;  ///< 1 - F(0): the injection's share of normal irradiance
+  double leaving = 1.0;   ///< diffuseBoundaryTransmittance(ior): the shading's exit share
+};
+
+std::unique_ptr<const BoundaryTable> buildBoundaryTable(double ior) {
+  auto table = std::make_unique<BoundaryTable>();
+  table->ior = ior;
+  table->rdOverAlbedo.resize(kReflectanceTable + 1);
+  for (int i = 0; i <= kReflectanceTable; ++i) {
+    const double t = double(i) / kReflectanceTable;
+    // t = 0: a non-absorbing half-space returns all the light that enters it (the solver
+    // gets there only as 1/thickness). t = 1: the albedo -> 0 limit of Rd / albedo, which
+    // Rd at albedo 1e-9 gives to a relative 1e-9.
+    const double albedo = i == 0 ? 1.0 : std::max(1e-9, 1.0 - t * t);
+    table->rdOverAlbedo[std::size_t(i)] =
+        i == 0 ? 1.0 - fresnelReflectance(1.0, ior) : addingDoublingHalfSpace(albedo, ior).rd / albedo;
+  }
+  table->entering = 1.0 - fresnelReflectance(1.0, ior);
+  table->leaving = diffuseBoundaryTransmittance(ior);
   return table;
+}
+
+/// Built once per ior on first use, kept for the process (a scene has one ior; the editor
+/// a few). The thread-local pointer skips the lock for the per-cell calls.
+const BoundaryTable& boundaryTable(double ior) {
+  thread_local const BoundaryTable* last = nullptr;
+  if (last != nullptr && last->ior == ior) return *last;
+  if (!(ior > 0.0) || !std::isfinite(ior)) throw std::invalid_argument("boundaryReflectance: ior must be positive");
+  static std::mutex mutex;
+  static std::map<double, std::unique_ptr<const BoundaryTable>> tables;
+  const std::lock_guard<std::mutex> lock(mutex);
+  std::unique_ptr<const BoundaryTable>& slot = tables[ior];
+  if (!slot) slot = buildBoundaryTable(ior);
+  last = slot.get();
+  return *last;
 }
 
 }  // namespace
@@ -58,13 +97,22 @@ bool parseLpvScheme(std::string_view name, LpvScheme& scheme) {
 
 std::string lpvSchemeName(LpvScheme scheme) { return scheme == LpvScheme::Seed ? "seed" : "calibrated"; }
 
-double halfSpaceReflectance(double albedo) {
-  const std::vector<double>& table = reflectanceTable();
-  const double t = std::sqrt(std::clamp(1.0 - albedo, 0.0, 1.0)) * kReflectanceTable;
-  const int i = std::min(int(t), kReflectanceTable - 1);
-  const double f = t - i;
-  return (1.0 - f) * table[i] + f * table[i + 1];
+double boundaryReflectance(double albedo, double ior) {
+  const std::vector<double>& table = boundaryTable(ior).rdOverAlbedo;
+  albedo = std::clamp(albedo, 0.0, 1.0);
+  // Cubic through the 4 nearest nodes: linear interpolation would be off by up to 4e-4
+  // relative near albedo 1 at η = 1.5, where Rd / albedo bends fastest in t.
+  const double t = std::sqrt(1.0 - albedo) * kReflectanceTable;
+  const int first = std::clamp(int(t) - 1, 0, kReflectanceTable - 3);
+  const double x = t - first;
+  const double weights[4] = {-(x - 1.0) * (x - 2.0) * (x - 3.0) / 6.0, x * (x - 2.0) * (x - 3.0) / 2.0,
+                             -x * (x - 1.0) * (x - 3.0) / 2.0, x * (x - 1.0) * (x - 2.0) / 6.0};
+  double value = 0.0;
+  for (int k = 0; k < 4; ++k) value += weights[k] * table[std::size_t(first + k)];
+  return albedo * value;
 }
+
+double halfSpaceReflectance(double albedo) { return boundaryReflectance(albedo, 1.0); }
 
 std::array<double, 3> injectedLobeSplit() {
   // A lobe pointing into the medium along -z; its neighbours in the order -x,+x,-y,+y,-z,+z.
@@ -95,9 +143,12 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   const double r = std::exp(-kappa);
   const double latticeReflectance = 3.0 * r * (split[1] + r * split[2]);
   const double reducedAlbedo = reducedT > 0.0 ? reducedS / reducedT : 1.0;
-  const double target = halfSpaceReflectance(reducedAlbedo) *
-                        (dipoleRd(reducedAlbedo, ior) / dipoleRd(reducedAlbedo, 1.0));
-  double gain = latticeReflectance > 0.0 ? ior * ior * target / latticeReflectance : 0.0;
+  // The injection has already taken 1 - F(0) of the irradiance and the shading lets out
+  // `leaving` of an isotropic cell's power, so this gain makes the lattice reflect the
+  // medium's Rd in total.
+  const BoundaryTable& boundary = boundaryTable(ior);
+  const double target = boundaryReflectance(reducedAlbedo, ior) / (boundary.entering * boundary.leaving);
+  double gain = latticeReflectance > 0.0 ? target / latticeReflectance : 0.0;
   if (!std::isfinite(gain) || reducedAlbedo <= 0.0) gain = 0.0;
   return {float(survival), 0.0f, float(gain)};
 }

@@ -1,0 +1,46 @@
+#pragma once
+// An analog Monte Carlo random walk for the reflectance of a half-space behind a smooth
+// dielectric boundary, independent of the reference tracer and of the adding-doubling
+// solver: both are checked against it (slab_reflectance_test, adding_doubling_test).
+#include <cmath>
+#include <cstdint>
+
+#include "volume/fresnel.h"
+#include "volume/reference_tracer.h"
+
+namespace sslpv::test {
+
+/// Reflected fraction of a collimated normal beam on an isotropically scattering
+/// half-space (σt = 1) with a smooth boundary of relative index eta: an analog random
+/// walk in depth and direction cosine only, with nothing in common with the tracer but
+/// fresnelReflectance. Specular reflection at entry is not counted.
+inline double halfSpaceWalk(double albedo, double eta, int photons, std::uint64_t seed, double& standardError) {
+  ReferenceRng rng(seed, 0, 0);
+  const double f0 = fresnelReflectance(1.0, eta);
+  int reflected = 0;
+  for (int k = 0; k < photons; ++k) {
+    if (rng.uniform() < f0) continue;
+    double z = 0.0, mu = 1.0;  // depth, and direction cosine with +z pointing down
+    while (true) {
+      z -= std::log(1.0 - rng.uniform()) * mu;
+      if (z < 0.0) {
+        const double sin2T = eta * eta * (1.0 - mu * mu);
+        const double reflect = sin2T >= 1.0 ? 1.0 : fresnelReflectance(std::sqrt(1.0 - sin2T), eta);
+        if (rng.uniform() < reflect) {  // mirrored back in; the flight restarts at the face
+          z = 0.0;
+          mu = -mu;
+          continue;
+        }
+        ++reflected;
+        break;
+      }
+      if (rng.uniform() >= albedo) break;
+      mu = 1.0 - 2.0 * rng.uniform();
+    }
+  }
+  const double p = double(reflected) / photons;
+  standardError = std::sqrt(p * (1.0 - p) / photons);
+  return p;
+}
+
+}  // namespace sslpv::test

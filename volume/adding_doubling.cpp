@@ -1,0 +1,340 @@
+// Adding-doubling for a semi-infinite isotropic medium behind a Fresnel boundary; the
+// method is described in adding_doubling.h.
+//
+// Conventions: n bins, matrices row-major n x n, entry (i, j) = power arriving in bin i per
+// unit power incident in bin j, so a column sum is the power a bin's light keeps. The
+// normal beam, not a node, is one more column beside them (r0, t0) plus its unscattered
+// fraction. The result is the exact solution of the discrete-ordinate equations in the
+// chosen nodes: the starting layer is exact (thinLayer) and doubling is exact algebra, so
+// the only approximation is the quadrature, which converges spectrally in the nodes.
+#include "volume/adding_doubling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "volume/fresnel.h"
+
+namespace sslpv {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Gauss–Legendre nodes and weights on [0, 1].
+void gaussLegendre01(int n, std::vector<double>& x, std::vector<double>& w) {
+  x.resize(std::size_t(n));
+  w.resize(std::size_t(n));
+  for (int i = 0; i < n; ++i) {
+    double z = std::cos(kPi * (i + 0.75) / (n + 0.5));
+    double derivative = 1.0;
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      double p0 = 1.0, p1 = z;
+      for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+      }
+      derivative = n * (z * p1 - p0) / (z * z - 1.0);
+      const double dz = p1 / derivative;
+      z -= dz;
+      if (std::abs(dz) < 1e-16) break;
+    }
+    x[std::size_t(i)] = 0.5 * (1.0 - z);
+    w[std::size_t(i)] = 1.0 / ((1.0 - z * z) * derivative * derivative);
+  }
+}
+
+/// Fresnel reflectance of light inside the medium arriving at the boundary with direction
+/// cosine mu: 1 beyond the critical angle, else that of the refracted pair (reciprocity).
+double internalFresnel(double mu, double eta) {
+  if (eta == 1.0) return 0.0;
+  const double sin2Out = eta * eta * (1.0 - mu * mu);
+  if (sin2Out >= 1.0) return 1.0;
+  return fresnelReflectance(std::sqrt(1.0 - sin2Out), eta);
+}
+
+/// Direction cosines inside the medium: Gauss on [0, 1], or for η > 1 Gauss on [0, μc]
+/// and Gauss in s on μ = μc + (1 - μc) s² (see the header).
+void boundaryQuadrature(int n, double eta, std::vector<double>& mu, std::vector<double>& weight) {
+  if (eta <= 1.0) {
+    gaussLegendre01(n, mu, weight);
+    return;
+  }
+  const double muC = std::sqrt(1.0 - 1.0 / (eta * eta));
+  const int lower = n / 2, upper = n - lower;
+  std::vector<double> x, w;
+  mu.clear();
+  weight.clear();
+  gaussLegendre01(lower, x, w);
+  for (int i = 0; i < lower; ++i) {
+    mu.push_back(muC * x[std::size_t(i)]);
+    weight.push_back(muC * w[std::size_t(i)]);
+  }
+  gaussLegendre01(upper, x, w);
+  for (int i = 0; i < upper; ++i) {
+    const double s = x[std::size_t(i)];
+    mu.push_back(muC + (1.0 - muC) * s * s);
+    weight.push_back((1.0 - muC) * 2.0 * s * w[std::size_t(i)]);
+  }
+}
+
+/// Dense row-major square matrices, just what doubling needs.
+struct Matrix {
+  int n = 0;
+  std::vector<double> a;
+  explicit Matrix(int size) : n(size), a(std::size_t(size) * std::size_t(size), 0.0) {}
+  double& operator()(int i, int j) { return a[std::size_t(i) * std::size_t(n) + std::size_t(j)]; }
+  double operator()(int i, int j) const { return a[std::size_t(i) * std::size_t(n) + std::size_t(j)]; }
+};
+
+/// out = x * y (out must not alias x or y).
+void multiply(const Matrix& x, const Matrix& y, Matrix& out) {
+  const int n = x.n;
+  std::fill(out.a.begin(), out.a.end(), 0.0);
+  for (int i = 0; i < n; ++i) {
+    double* row = &out.a[std::size_t(i) * std::size_t(n)];
+    for (int k = 0; k < n; ++k) {
+      const double xik = x(i, k);
+      const double* yRow = &y.a[std::size_t(k) * std::size_t(n)];
+      for (int j = 0; j < n; ++j) row[j] += xik * yRow[j];
+    }
+  }
+}
+
+std::vector<double> multiply(const Matrix& x, const std::vector<double>& v) {
+  std::vector<double> out(std::size_t(x.n), 0.0);
+  for (int i = 0; i < x.n; ++i)
+    for (int j = 0; j < x.n; ++j) out[std::size_t(i)] += x(i, j) * v[std::size_t(j)];
+  return out;
+}
+
+/// LU factorisation with partial pivoting, in place; then solves in place.
+class Lu {
+ public:
+  explicit Lu(Matrix m) : lu_(std::move(m)), pivot_(std::size_t(lu_.n)) {
+    const int n = lu_.n;
+    for (int k = 0; k < n; ++k) {
+      int p = k;
+      for (int i = k + 1; i < n; ++i)
+        if (std::abs(lu_(i, k)) > std::abs(lu_(p, k))) p = i;
+      pivot_[std::size_t(k)] = p;
+      if (p != k)
+        for (int j = 0; j < n; ++j) std::swap(lu_(k, j), lu_(p, j));
+      const double inverse = 1.0 / lu_(k, k);
+      for (int i = k + 1; i < n; ++i) {
+        const double factor = lu_(i, k) *= inverse;
+        for (int j = k + 1; j < n; ++j) lu_(i, j) -= factor * lu_(k, j);
+      }
+    }
+  }
+
+  /// Overwrites every column of b with the solution of (this) x = column.
+  void solve(Matrix& b) const {
+    const int n = lu_.n;
+    for (int k = 0; k < n; ++k) {
+      const int p = pivot_[std::size_t(k)];
+      if (p != k)
+        for (int j = 0; j < n; ++j) std::swap(b(k, j), b(p, j));
+    }
+    for (int k = 0; k < n; ++k)
+      for (int i = k + 1; i < n; ++i) {
+        const double factor = lu_(i, k);
+        for (int j = 0; j < n; ++j) b(i, j) -= factor * b(k, j);
+      }
+    for (int k = n - 1; k >= 0; --k) {
+      const double inverse = 1.0 / lu_(k, k);
+      for (int j = 0; j < n; ++j) b(k, j) *= inverse;
+      for (int i = 0; i < k; ++i) {
+        const double factor = lu_(i, k);
+        for (int j = 0; j < n; ++j) b(i, j) -= factor * b(k, j);
+      }
+    }
+  }
+
+  void solve(std::vector<double>& b) const {
+    const int n = lu_.n;
+    for (int k = 0; k < n; ++k) std::swap(b[std::size_t(k)], b[std::size_t(pivot_[std::size_t(k)])]);
+    for (int k = 0; k < n; ++k)
+      for (int i = k + 1; i < n; ++i) b[std::size_t(i)] -= lu_(i, k) * b[std::size_t(k)];
+    for (int k = n - 1; k >= 0; --k) {
+      b[std::size_t(k)] /= lu_(k, k);
+      for (int i = 0; i < k; ++i) b[std::size_t(i)] -= lu_(i, k) * b[std::size_t(k)];
+    }
+  }
+
+ private:
+  Matrix lu_;
+  std::vector<int> pivot_;
+};
+
+/// Reflection and transmission of a layer of optical thickness `delta`, exact for the
+/// discrete-ordinate equations. With f+ (f-) the downward (upward) power per bin and b the
+/// normal beam, d/dτ [f+, f-, b] = K [f+, f-, b] with
+///   K = [[S - D, S, s], [-S, D - S, -s], [0, 0, -1]],  D = diag(1/μ), S_ij = ω w_i / (2 μ_j),
+/// s_i = ω w_i / 2 (scattered power per unit depth, isotropic: half into each hemisphere,
+/// shared by solid angle 2π w_i). M = exp(δK) by its Taylor series; nothing enters from
+/// below (f-(δ) = 0) gives R = -M22^-1 M21 and T = M11 + M12 R, the beam's columns alike.
+/// For ω = 1, [1, -1, 1]ᵀ K = 0, so every Taylor term conserves power: the starting layer
+/// neither gains nor loses any, which doubling to great thickness needs.
+void thinLayer(double albedo, const std::vector<double>& mu, const std::vector<double>& w, double delta, Matrix& r,
+               Matrix& t, std::vector<double>& r0, std::vector<double>& t0) {
+  // δK = Λ + p qᵀ: diagonal extinction plus rank-one isotropic scattering, with
+  // Λ = δ diag(-1/μ, 1/μ, -1), p = (w, -w, 0), q = δ (ω/2) (1/μ, 1/μ, 1). So each Taylor
+  // term costs O(m²): (X δK)_ij = X_ij Λ_j + (X p)_i q_j.
+  const int n = int(mu.size()), m = 2 * n + 1;
+  const std::size_t size = std::size_t(m);
+  std::vector<double> lambda(size), p(size, 0.0), q(size);
+  for (int i = 0; i < n; ++i) {
+    lambda[std::size_t(i)] = -delta / mu[std::size_t(i)];
+    lambda[std::size_t(n + i)] = delta / mu[std::size_t(i)];
+    p[std::size_t(i)] = w[std::size_t(i)];
+    p[std::size_t(n + i)] = -w[std::size_t(i)];
+    q[std::size_t(i)] = q[std::size_t(n + i)] = delta * 0.5 * albedo / mu[std::size_t(i)];
+  }
+  lambda[std::size_t(2 * n)] = -delta;
+  q[std::size_t(2 * n)] = delta * 0.5 * albedo;
+  Matrix sum(m), term(m);
+  for (int i = 0; i < m; ++i) sum(i, i) = term(i, i) = 1.0;
+  for (int order = 1; order < 100; ++order) {
+    double largest = 0.0;
+    for (int i = 0; i < m; ++i) {
+      double* row = &term.a[std::size_t(i) * std::size_t(m)];
+      double* out = &sum.a[std::size_t(i) * std::size_t(m)];
+      double rowP = 0.0;
+      for (int j = 0; j < m; ++j) rowP += row[j] * p[std::size_t(j)];
+      for (int j = 0; j < m; ++j) {
+        row[j] = (row[j] * lambda[std::size_t(j)] + rowP * q[std::size_t(j)]) / order;
+        out[j] += row[j];
+        largest = std::max(largest, std::abs(row[j]));
+      }
+    }
+    if (largest < 1e-18) break;
+  }
+  Matrix m22(n), rhs(n);
+  std::vector<double> beam(mu.size());
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      m22(i, j) = sum(n + i, n + j);
+      rhs(i, j) = -sum(n + i, j);
+    }
+    beam[std::size_t(i)] = -sum(n + i, 2 * n);
+  }
+  const Lu lu(m22);
+  lu.solve(rhs);
+  lu.solve(beam);
+  r = rhs;
+  r0 = beam;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      double v = sum(i, j);
+      for (int l = 0; l < n; ++l) v += sum(i, n + l) * r(l, j);
+      t(i, j) = v;
+    }
+    double v = sum(i, 2 * n);
+    for (int l = 0; l < n; ++l) v += sum(i, n + l) * r0[std::size_t(l)];
+    t0[std::size_t(i)] = v;
+  }
+}
+
+}  // namespace
+
+HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const AddingDoublingOptions& options) {
+  if (!(albedo >= 0.0 && albedo <= 1.0))
+    throw std::invalid_argument("addingDoublingHalfSpace: albedo must be in [0, 1]");
+  if (!(eta > 0.0) || !std::isfinite(eta)) throw std::invalid_argument("addingDoublingHalfSpace: eta must be positive");
+  if (options.nodes < 2) throw std::invalid_argument("addingDoublingHalfSpace: need at least 2 nodes");
+  if (!(options.transmittanceTolerance > 0.0) || !(options.maxThickness > 0.0))
+    throw std::invalid_argument("addingDoublingHalfSpace: tolerance and thickness must be positive");
+
+  HalfSpaceReflectance result;
+  boundaryQuadrature(options.nodes, eta, result.mu, result.weight);
+  const int n = int(result.mu.size());
+  const std::vector<double>& mu = result.mu;
+  const std::vector<double>& w = result.weight;
+
+  // The starting layer: its transfer matrix exp(δK) (see thinLayer) is well conditioned
+  // while δ/μ stays near 1 and its Taylor series then converges in ~20 terms.
+  const double muMin = *std::min_element(mu.begin(), mu.end());
+  double delta = 1.0;
+  while (delta > 0.5 * muMin) delta *= 0.5;
+  const std::size_t bins = mu.size();
+  Matrix r(n), t(n);
+  std::vector<double> r0(bins), t0(bins);
+  thinLayer(albedo, mu, w, delta, r, t, r0, t0);
+  double direct = std::exp(-delta);  // the normal beam's unscattered fraction
+
+  Matrix a(n), x(n), tr(n), next(n);
+  double thickness = delta;
+  double transmittance = 1.0;
+  while (true) {
+    // Two copies of the layer, one on the other. Between them the downward power d and
+    // the upward power u satisfy d = (from above) + R u and u = R d + (from below), hence
+    // (I - R R)^-1. The beam: the upper copy passes `direct` of it unscattered and t0
+    // scattered downward; the lower copy reflects the unscattered part as direct * r0.
+    multiply(r, r, a);
+    for (double& v : a.a) v = -v;
+    for (int i = 0; i < n; ++i) a(i, i) += 1.0;
+    const Lu lu(a);
+    std::vector<double> d = multiply(r, r0);
+    for (int i = 0; i < n; ++i) d[std::size_t(i)] = t0[std::size_t(i)] + direct * d[std::size_t(i)];
+    lu.solve(d);
+    std::vector<double> u = multiply(r, d);
+    for (int i = 0; i < n; ++i) u[std::size_t(i)] += direct * r0[std::size_t(i)];
+    const std::vector<double> reflectedBack = multiply(t, u), passedDown = multiply(t, d);
+    for (int i = 0; i < n; ++i) {
+      r0[std::size_t(i)] += reflectedBack[std::size_t(i)];
+      t0[std::size_t(i)] = passedDown[std::size_t(i)] + direct * t0[std::size_t(i)];
+    }
+    direct *= direct;
+
+    x = t;
+    lu.solve(x);  // (I - R R)^-1 T
+    multiply(t, r, tr);
+    multiply(tr, x, next);
+    for (std::size_t k = 0; k < r.a.size(); ++k) r.a[k] += next.a[k];
+    multiply(t, x, next);
+    std::swap(t.a, next.a);
+    thickness *= 2.0;
+    ++result.doublings;
+
+    transmittance = direct;
+    for (double v : t0) transmittance += v;
+    for (int j = 0; j < n; ++j) {
+      double column = 0.0;
+      for (int i = 0; i < n; ++i) column += t(i, j);
+      transmittance = std::max(transmittance, column);
+    }
+    if (transmittance < options.transmittanceTolerance || thickness >= options.maxThickness) break;
+  }
+  result.thickness = thickness;
+  result.transmittance = transmittance;
+
+  // The boundary: upward power u reaching it is F u reflected back into the same bins,
+  // which the half-space reflects again: u = (1 - F(0)) r0 + R F u.
+  std::vector<double> fresnel(bins);
+  for (int i = 0; i < n; ++i) fresnel[std::size_t(i)] = internalFresnel(mu[std::size_t(i)], eta);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) a(i, j) = (i == j ? 1.0 : 0.0) - r(i, j) * fresnel[std::size_t(j)];
+  std::vector<double> u = r0;
+  const double entering = 1.0 - fresnelReflectance(1.0, eta);
+  for (double& v : u) v *= entering;
+  Lu(a).solve(u);
+  result.exitFlux.resize(bins);
+  for (int i = 0; i < n; ++i) {
+    result.exitFlux[std::size_t(i)] = (1.0 - fresnel[std::size_t(i)]) * u[std::size_t(i)];
+    result.rd += result.exitFlux[std::size_t(i)];
+  }
+  return result;
+}
+
+double diffuseBoundaryTransmittance(double eta) {
+  if (!(eta > 0.0) || !std::isfinite(eta))
+    throw std::invalid_argument("diffuseBoundaryTransmittance: eta must be positive");
+  std::vector<double> mu, w;
+  boundaryQuadrature(64, eta, mu, w);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < mu.size(); ++i) sum += 2.0 * w[i] * mu[i] * (1.0 - internalFresnel(mu[i], eta));
+  return sum;
+}
+
+}  // namespace sslpv
