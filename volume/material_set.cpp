@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <mutex>
 #include <ostream>
@@ -20,6 +21,17 @@
 namespace sslpv {
 namespace {
 namespace fs = std::filesystem;
+
+/// io::File::write ignores the stream's state, so a full disk left a truncated file that
+/// the atomic rename then put in place. This writes the same archive (seekable, as
+/// io::File does) to a stream whose state the caller checks.
+class CheckedVdbWriter : public openvdb::io::File {
+ public:
+  using openvdb::io::File::File;
+  void writeTo(std::ostream& stream, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta) const {
+    openvdb::io::Archive::write(stream, grids, /*seekable=*/true, meta);
+  }
+};
 
 constexpr const char* kSigmaT = "sigma_t";
 constexpr const char* kSigmaS = "sigma_s";
@@ -260,13 +272,15 @@ void saveMaterialSet(const MaterialSet& set, const fs::path& file) {
   meta.insertMeta("creator", openvdb::StringMetadata(set.creator.empty() ? "sslpv" : set.creator));
   meta.insertMeta("version", openvdb::Int32Metadata(kFormatVersion));
   writeAtomically(file, [&](const fs::path& temp) {
+    std::ofstream stream(temp, std::ios::binary | std::ios::trunc);
+    if (!stream) throw InputError(name + ": cannot write the VDB file: cannot create " + temp.string());
     try {
-      openvdb::io::File out(temp.string());
-      out.write(grids, meta);
-      out.close();
+      CheckedVdbWriter(temp.string()).writeTo(stream, grids, meta);
     } catch (const openvdb::Exception& e) {
       throw InputError(name + ": cannot write the VDB file: " + e.what());
     }
+    stream.close();
+    if (stream.fail()) throw InputError(name + ": cannot write the VDB file (disk full or file too large?)");
   });
 }
 
