@@ -1,0 +1,72 @@
+#pragma once
+// The editor's brush panel as state: which channel, mode, value, radius, falloff, strength,
+// mirror and depth the next stroke uses, changed by the window's keys. No VTK, so the
+// rules (what each key does, which modes a channel accepts) are tested headless.
+//
+// Values are remembered per channel and mode: a set target, an add amount and a multiply
+// factor mean different things, so switching mode does not reinterpret the last number.
+#include <array>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "editor/brush_engine.h"
+
+namespace sslpv {
+
+class BrushControls {
+ public:
+  /// Defaults from the scene: set targets start at the base material (σt doubled, so a
+  /// first stroke is visible), radius at 8 % of the object's longest world extent.
+  BrushControls(const MaterialSample& basePerSceneUnit, double objectWorldExtent, std::string sceneUnits);
+
+  /// The brush the next stroke uses (always passes brushProblem()).
+  Brush brush() const;
+
+  void cycleChannel(int direction);  ///< sigma_t, sigma_s, g, albedo_mfp, preset, all
+  void cycleMode(int direction);     ///< only the modes the channel accepts
+  void cycleFalloff();
+  void scaleRadius(double factor);
+  void adjustStrength(double delta);
+  /// The channel's main number one notch up (+1) or down (-1): σ values and mean free
+  /// paths by a factor 1.25, g by 0.05, a preset to the next/previous Jensen material.
+  void adjustValue(int direction);
+  /// albedo_mfp: the albedo of the selected component(s) by 0.02.
+  void adjustAlbedo(int direction);
+  /// Which RGB component adjustValue/adjustAlbedo change: all, then r, g, b.
+  void cycleComponent();
+  void negateValue();  ///< add mode: paint the opposite amount
+  void cycleMirror();  ///< off, x, y, z (across the object's rest-space centre)
+  void adjustDepth(int direction);  ///< surface strokes' depth by a tenth of the radius
+
+  bool paintMode() const { return paintMode_; }
+  void setPaintMode(bool on) { paintMode_ = on; }
+
+  /// One status line: "sigma_t set [1.2 1.5 2] /mm | radius 1.5 mm | smooth | ...".
+  std::string describe() const;
+  /// What the slice views show for this brush: "sigma_t", "sigma_s", "g" or "albedo".
+  std::string displayChannel() const;
+
+ private:
+  using Key = std::pair<BrushChannel, BrushMode>;
+  glm::dvec3& rgbValue();
+  double& scalarValue();
+
+  BrushChannel channel_ = BrushChannel::SigmaT;
+  BrushMode mode_ = BrushMode::Set;
+  std::map<Key, glm::dvec3> rgb_;
+  std::map<Key, double> scalar_;
+  glm::dvec3 albedo_{0.9};
+  glm::dvec3 meanFreePath_{1.0};
+  std::size_t preset_ = 0;
+  int component_ = -1;  ///< -1: all three
+  double radius_ = 1.0;
+  BrushFalloff falloff_ = BrushFalloff::Smooth;
+  double strength_ = 0.5;
+  int mirrorAxis_ = -1;
+  double depth_ = 0.0;
+  bool paintMode_ = true;
+  std::string units_;
+};
+
+}  // namespace sslpv

@@ -1,0 +1,435 @@
+#include "editor/edit_session.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <system_error>
+
+#include "volume/atomic_file.h"
+#include "volume/error.h"
+#include "volume/material_set.h"
+
+namespace sslpv {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kCreator = "sslpv edit";
+constexpr int kMinPreviewSide = 16;
+
+fs::path recoveryPathFor(const fs::path& sceneFile) {
+  fs::path p = sceneFile;
+  p += ".recovery.vdb";
+  return p;
+}
+
+std::string readFile(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot read the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(file.string() + ": cannot read the file");
+  return text.str();
+}
+
+void writeFile(const fs::path& file, const std::string& text, const fs::path& target) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(target.string() + ": cannot write the file");
+  out << text;
+  out.flush();
+  if (!out) throw InputError(target.string() + ": cannot write the file (disk full?)");
+}
+
+bool hasVdbExtension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".vdb";
+}
+
+/// A shallow copy (grids shared) carrying the editor as creator.
+MaterialSet forWriting(const MaterialSet& set) {
+  MaterialSet out = set;
+  out.creator = kCreator;
+  return out;
+}
+
+void unite(std::optional<Bounds>& into, const Bounds& b) {
+  if (b.empty()) return;
+  if (!into) {
+    into = b;
+  } else {
+    into->extend(b.min);
+    into->extend(b.max);
+  }
+}
+
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// The checks the scene loader applies to a camera, for cameras coming from the window.
+void checkCamera(const Camera& c) {
+  const std::string what = "preview camera: ";
+  if (!finite(c.position) || !finite(c.target) || !finite(c.up))
+    throw InputError(what + "position, target and up must be finite");
+  if (!(c.fovYDeg > 0.0 && c.fovYDeg < 180.0)) throw InputError(what + "fov_y_deg must be in (0, 180)");
+  const glm::dvec3 view = c.target - c.position;
+  const double length = glm::length(view);
+  if (!(length > 0.0)) throw InputError(what + "target equals position: the view direction is undefined");
+  const double up = glm::length(c.up);
+  if (!(up > 0.0) || glm::length(glm::cross(view / length, c.up / up)) < 1e-6)
+    throw InputError(what + "up is parallel to the view direction");
+}
+
+void checkSettings(const LpvSettings& s) {
+  if (s.resolution < 2 || s.resolution > kMaxLpvResolution)
+    throw InputError("preview lpv.resolution: expected an integer in [2, " + std::to_string(kMaxLpvResolution) +
+                     "], got " + std::to_string(s.resolution));
+  if (!s.autoSteps && (s.steps < 1 || s.steps > kMaxSteps))
+    throw InputError("preview lpv.steps: expected an integer in [1, " + std::to_string(kMaxSteps) + "], got " +
+                     std::to_string(s.steps));
+  if (s.shadowMap < 1 || s.shadowMap > kMaxShadowMap)
+    throw InputError("preview lpv.shadow_map: expected an integer in [1, " + std::to_string(kMaxShadowMap) +
+                     "], got " + std::to_string(s.shadowMap));
+}
+
+}  // namespace
+
+std::optional<fs::path> findRecoveryFile(const fs::path& sceneFile) {
+  const fs::path file = recoveryPathFor(sceneFile);
+  std::error_code ec;
+  if (fs::is_regular_file(file, ec)) return file;
+  return std::nullopt;
+}
+
+struct EditSession::Impl {
+  Scene scene;
+  SessionPaths paths;
+  /// makePaintTarget(scene) without its set: what recover() puts the recovered set into.
+  PaintTarget targetTemplate;
+  std::unique_ptr<BrushEngine> engine;
+
+  // Saved state. Every history entry carries a revision id; undoIds/redoIds mirror the
+  // engine's undo and redo stacks, baseId is the state below the whole history. A stroke
+  // that changed no voxel shares the id of the state it started from (nothing differs).
+  std::uint64_t baseId = 0;
+  std::uint64_t nextId = 1;
+  std::uint64_t savedId = 0;
+  std::vector<std::uint64_t> undoIds, redoIds;
+  bool strokeWrote = false;  ///< the stroke in progress has written voxels
+  std::uint64_t changes = 0;
+  std::uint64_t autosavedChanges = 0;
+
+  // Preview.
+  std::unique_ptr<PreviewRenderer> renderer;
+  LpvSettings settings;
+  int previewWidth = 0, previewHeight = 0;
+  Camera camera;
+  std::optional<Bounds> touched;  ///< world region changed since the last renderPreview
+  bool resampleAll = true;        ///< the whole set changed (start, recover, a region lost)
+  bool stale = true;
+
+  std::uint64_t topId() const { return undoIds.empty() ? baseId : undoIds.back(); }
+
+  void materialChanged(const Bounds& region) {
+    unite(touched, region);
+    stale = true;
+  }
+
+  StrokeResult recordStroke(const StrokeResult& result) {
+    undoIds.push_back(result.voxelsChanged > 0 ? nextId++ : topId());
+    redoIds.clear();  // the engine drops its redo records too
+    strokeWrote = false;
+    ++changes;
+    materialChanged(result.worldBounds);
+    return result;
+  }
+
+  template <class Call>
+  DabResult dabs(Call&& call) {
+    try {
+      const DabResult result = call();
+      if (result.voxelsWritten > 0) {
+        strokeWrote = true;
+        materialChanged(result.worldBounds);
+      }
+      return result;
+    } catch (...) {
+      // Dabs before the failing one may have written voxels whose region was not returned.
+      if (engine->strokeInProgress()) {
+        resampleAll = true;
+        stale = true;
+      }
+      throw;
+    }
+  }
+
+  void requireNoStroke(const char* action) const {
+    if (engine->strokeInProgress())
+      throw InputError(std::string(action) + ": a stroke is in progress; end it first");
+  }
+};
+
+EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& preview)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.scene = loadScene(sceneFile);
+  m.paths.scene = sceneFile;
+  m.paths.recovery = recoveryPathFor(sceneFile);
+  if (m.scene.material.vdb) {
+    m.paths.saveTarget = *m.scene.material.vdb;
+  } else {
+    // Normalized as the scene loader resolves material.vdb, so scene().material.vdb
+    // compares equal after the save.
+    m.paths.saveTarget = (sceneFile.parent_path() / (sceneFile.stem().string() + "_material.vdb")).lexically_normal();
+    m.paths.saveUpdatesScene = true;
+  }
+
+  PaintTarget target = makePaintTarget(m.scene);
+  m.targetTemplate = target;
+  m.targetTemplate.set.reset();
+  m.engine = std::make_unique<BrushEngine>(std::move(target));
+
+  m.settings = preview.lpv.value_or(m.scene.lpv);
+  checkSettings(m.settings);
+  if (preview.longestSide < kMinPreviewSide || preview.longestSide > kMaxImageSide)
+    throw InputError("preview size: the longest side must be in [" + std::to_string(kMinPreviewSide) + ", " +
+                     std::to_string(kMaxImageSide) + "] pixels, got " + std::to_string(preview.longestSide));
+  const Camera& sceneCamera = m.scene.camera;
+  const double scale = double(preview.longestSide) / double(std::max(sceneCamera.width, sceneCamera.height));
+  m.previewWidth = std::max(kMinPreviewSide, int(std::lround(sceneCamera.width * scale)));
+  m.previewHeight = std::max(kMinPreviewSide, int(std::lround(sceneCamera.height * scale)));
+  m.camera = sceneCamera;
+  m.camera.width = m.previewWidth;
+  m.camera.height = m.previewHeight;
+
+  // The renderer gets the engine's live set before its first frame, so it need not load
+  // the file again.
+  Scene previewScene = m.scene;
+  previewScene.camera = m.camera;
+  previewScene.material.vdb.reset();
+  m.renderer = makePreviewRenderer(previewScene, preview.backend);
+}
+
+EditSession::~EditSession() = default;
+
+const Scene& EditSession::scene() const { return impl_->scene; }
+const SessionPaths& EditSession::paths() const { return impl_->paths; }
+const BrushEngine& EditSession::engine() const { return *impl_->engine; }
+const TriangleMesh& EditSession::worldMesh() const { return *impl_->targetTemplate.worldMesh; }
+
+void EditSession::beginStroke(const Brush& brush) {
+  Impl& m = *impl_;
+  // The engine would end the running stroke itself; ending it here records it.
+  if (m.engine->strokeInProgress()) endStroke();
+  m.engine->beginStroke(brush);
+  m.strokeWrote = false;
+}
+
+DabResult EditSession::addPoints(const std::vector<glm::dvec3>& worldPoints) {
+  Impl& m = *impl_;
+  return m.dabs([&] { return m.engine->addPoints(worldPoints); });
+}
+
+DabResult EditSession::addRays(const std::vector<SurfaceRay>& worldRays) {
+  Impl& m = *impl_;
+  return m.dabs([&] { return m.engine->addRays(worldRays); });
+}
+
+StrokeResult EditSession::endStroke() {
+  Impl& m = *impl_;
+  return m.recordStroke(m.engine->endStroke());
+}
+
+StrokeResult EditSession::applyStroke(const Stroke& stroke) {
+  // The engine's applyStroke, step by step, so every history entry gets its id.
+  beginStroke(stroke.brush);
+  try {
+    if (!stroke.points.empty()) addPoints(stroke.points);
+    if (!stroke.rays.empty()) addRays(stroke.rays);
+  } catch (...) {
+    endStroke();
+    throw;
+  }
+  return endStroke();
+}
+
+std::optional<StrokeResult> EditSession::undo() {
+  Impl& m = *impl_;
+  std::optional<StrokeResult> result = m.engine->undo();
+  if (!result) return result;
+  m.redoIds.push_back(m.undoIds.back());
+  m.undoIds.pop_back();
+  ++m.changes;
+  m.materialChanged(result->worldBounds);
+  m.stale = true;
+  return result;
+}
+
+std::optional<StrokeResult> EditSession::redo() {
+  Impl& m = *impl_;
+  std::optional<StrokeResult> result = m.engine->redo();
+  if (!result) return result;
+  m.undoIds.push_back(m.redoIds.back());
+  m.redoIds.pop_back();
+  ++m.changes;
+  m.materialChanged(result->worldBounds);
+  m.stale = true;
+  return result;
+}
+
+bool EditSession::canUndo() const { return impl_->engine->canUndo(); }
+bool EditSession::canRedo() const { return impl_->engine->canRedo(); }
+
+bool EditSession::unsaved() const { return impl_->strokeWrote || impl_->topId() != impl_->savedId; }
+std::uint64_t EditSession::changeCount() const { return impl_->changes; }
+
+void EditSession::setPreviewCamera(const Camera& camera) {
+  Impl& m = *impl_;
+  checkCamera(camera);
+  m.camera = camera;
+  m.camera.width = m.previewWidth;
+  m.camera.height = m.previewHeight;
+  m.renderer->setCamera(m.camera);
+  m.stale = true;
+}
+
+const Camera& EditSession::previewCamera() const { return impl_->camera; }
+bool EditSession::previewStale() const { return impl_->stale; }
+
+Image EditSession::renderPreview(RenderReport* report) {
+  Impl& m = *impl_;
+  // The set is painted in place, so the renderer's pointer already sees the new voxels;
+  // passing it again rebuilds the field and hands over the region to resample.
+  if (m.resampleAll)
+    m.renderer->setMaterialSet(m.engine->materialSet(), std::nullopt);
+  else if (m.touched)
+    m.renderer->setMaterialSet(m.engine->materialSet(), m.touched);
+  m.resampleAll = false;
+  m.touched.reset();
+  Image image = m.renderer->render(m.settings, report);
+  m.stale = false;
+  return image;
+}
+
+std::string EditSession::previewBackendName() const { return impl_->renderer->name(); }
+const LpvSettings& EditSession::previewSettings() const { return impl_->settings; }
+
+void EditSession::save() {
+  Impl& m = *impl_;
+  // Mid-stroke the voxels match no history position, so "saved" could not be recorded.
+  m.requireNoStroke("save");
+  const MaterialSet out = forWriting(*m.engine->materialSet());
+  const fs::path& target = m.paths.saveTarget;
+  if (!m.paths.saveUpdatesScene) {
+    saveMaterialSet(out, target);
+  } else {
+    const fs::path& sceneFile = m.paths.scene;
+    requireWritableOutput(target);
+    requireWritableOutput(sceneFile);
+    const std::string original = readFile(sceneFile);
+    nlohmann::ordered_json doc;
+    try {
+      doc = nlohmann::ordered_json::parse(original);
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(sceneFile.string() + ": cannot rewrite the scene, it no longer parses: " + e.what());
+    }
+    if (!doc.is_object() || !doc.contains("material") || !doc["material"].is_object())
+      throw InputError(sceneFile.string() + ": cannot rewrite the scene: 'material' is not an object");
+    doc["material"]["vdb"] = target.filename().string();
+    const std::string rewritten = doc.dump(2) + "\n";
+    // Refuse to write a scene the loader would reject (the file may have changed on disk).
+    parseScene(rewritten, sceneFile);
+
+    // The material goes to a temporary sibling, the scene is replaced, then the material
+    // is renamed into place: a failure at any step leaves both previous files.
+    bool sceneWritten = false;
+    try {
+      writeAtomically(target, [&](const fs::path& temp) {
+        saveMaterialSet(out, temp);
+        writeAtomically(sceneFile, [&](const fs::path& sceneTemp) { writeFile(sceneTemp, rewritten, sceneFile); });
+        sceneWritten = true;
+      });
+    } catch (...) {
+      if (sceneWritten) {
+        // The material was not renamed into place: the scene must not name it.
+        try {
+          writeAtomically(sceneFile, [&](const fs::path& sceneTemp) { writeFile(sceneTemp, original, sceneFile); });
+        } catch (...) {
+        }
+      }
+      throw;
+    }
+    m.scene.material.vdb = target;
+    m.paths.saveUpdatesScene = false;
+  }
+  m.savedId = m.topId();
+  // The saved file now holds everything the recovery file did.
+  std::error_code ignored;
+  fs::remove(m.paths.recovery, ignored);
+}
+
+void EditSession::exportMaterialSet(const fs::path& vdbFile) const {
+  if (!hasVdbExtension(vdbFile)) throw InputError(vdbFile.string() + ": the export must be a .vdb file");
+  requireWritableOutput(vdbFile);
+  saveMaterialSet(forWriting(*impl_->engine->materialSet()), vdbFile);
+}
+
+void EditSession::autosave() {
+  Impl& m = *impl_;
+  saveMaterialSet(forWriting(*m.engine->materialSet()), m.paths.recovery);
+  m.autosavedChanges = m.changes;
+}
+
+bool EditSession::autosaveStale() const { return unsaved() && impl_->changes != impl_->autosavedChanges; }
+
+void EditSession::recover() {
+  Impl& m = *impl_;
+  // The window's drag would continue on an engine that no longer has its stroke.
+  m.requireNoStroke("recover");
+  const fs::path& file = m.paths.recovery;
+  std::shared_ptr<const MaterialSet> loaded;
+  try {
+    loaded = loadMaterialSet(file);
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    if (message.find(file.string()) != std::string::npos) throw;
+    throw InputError(file.string() + ": " + message);
+  }
+  // Painting needs its own grids: the loaded ones are const and may be shared.
+  auto set = std::make_shared<MaterialSet>(*loaded);
+  set->sigmaT = loaded->sigmaT->deepCopy();
+  set->sigmaS = loaded->sigmaS->deepCopy();
+  if (loaded->g) set->g = loaded->g->deepCopy();
+  PaintTarget target = m.targetTemplate;
+  target.set = std::move(set);
+  std::unique_ptr<BrushEngine> engine;
+  try {
+    engine = std::make_unique<BrushEngine>(std::move(target));
+  } catch (const InputError& e) {
+    throw InputError(file.string() + ": does not fit the scene: " + e.what());
+  }
+
+  // Nothing below throws: the session changes only once the recovered set is usable.
+  m.engine = std::move(engine);
+  m.undoIds.clear();
+  m.redoIds.clear();
+  m.baseId = m.nextId++;  // never the saved id: a recovered state is unsaved
+  m.strokeWrote = false;
+  ++m.changes;
+  m.autosavedChanges = m.changes;  // the recovery file holds exactly this state
+  m.touched.reset();
+  m.resampleAll = true;
+  m.stale = true;
+}
+
+void EditSession::discardRecovery() {
+  const fs::path& file = impl_->paths.recovery;
+  std::error_code ec;
+  fs::remove(file, ec);
+  if (ec) throw InputError(file.string() + ": cannot delete the recovery file: " + ec.message());
+}
+
+}  // namespace sslpv

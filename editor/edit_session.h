@@ -1,0 +1,133 @@
+#pragma once
+// The editor's document: one scene, its material set being painted (BrushEngine), the
+// live SSLPV preview, and the file side (save, export, autosave, crash recovery). No VTK:
+// the window (editor/ui/) drives it, tests and benchmarks drive it headless.
+//
+// Files. Save writes the painted set to the scene's material.vdb. A scene without one
+// gets <scene dir>/<scene stem>_material.vdb, and Save then also rewrites the scene JSON
+// so that material.vdb names it (keys and values kept, key order kept). Every write is
+// atomic (temporary file + rename): a failed save leaves the previous file and the
+// in-memory state (painted voxels, history, unsaved flag) exactly as they were.
+//
+// Recovery. While there are unsaved changes the window calls autosave() a few seconds
+// after the last change; it writes the current set to <scene file>.recovery.vdb (same
+// directory as the scene). A normal save or a clean exit deletes that file, so finding it
+// at start means the previous session ended without saving (crash, kill): the window
+// offers recover() or discardRecovery(). The undo history is not part of the recovery
+// file; a recovered state counts as unsaved.
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "editor/brush_engine.h"
+#include "volume/frame_report.h"
+#include "volume/image_io.h"
+#include "volume/scene.h"
+
+namespace sslpv {
+
+enum class PreviewBackendKind { Cpu, Vulkan };
+
+/// The renderers' common face (CpuRenderer, VulkanRenderer), so the preview does not care.
+class PreviewRenderer {
+ public:
+  virtual ~PreviewRenderer() = default;
+  virtual Image render(const LpvSettings& settings, RenderReport* report) = 0;
+  virtual void setCamera(const Camera& camera) = 0;
+  virtual void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) = 0;
+  /// "cpu" or "vulkan (<device name>)".
+  virtual std::string name() const = 0;
+};
+
+/// The preview renderer for `scene` (whose camera sets the preview's size). Vulkan creates
+/// its own device; throws GpuError (gpu/vk_check.h) when there is none, InputError on a
+/// bad scene.
+std::unique_ptr<PreviewRenderer> makePreviewRenderer(const Scene& scene, PreviewBackendKind backend);
+
+struct PreviewOptions {
+  PreviewBackendKind backend = PreviewBackendKind::Cpu;
+  /// Longest side of the preview image in pixels; the scene camera's aspect is kept.
+  int longestSide = 256;
+  /// LPV settings of the preview; absent: the scene's lpv settings.
+  std::optional<LpvSettings> lpv;
+};
+
+struct SessionPaths {
+  std::filesystem::path scene;       ///< the scene JSON
+  std::filesystem::path saveTarget;  ///< where save() writes the material set
+  bool saveUpdatesScene = false;     ///< the scene had no material.vdb: save() also rewrites the scene JSON
+  std::filesystem::path recovery;    ///< <scene file>.recovery.vdb
+};
+
+/// The recovery file <scene file>.recovery.vdb when it exists.
+std::optional<std::filesystem::path> findRecoveryFile(const std::filesystem::path& sceneFile);
+
+class EditSession {
+ public:
+  /// Loads the scene, its mesh and material set (InputError naming the file on bad input)
+  /// and creates the preview renderer (GpuError when Vulkan was asked for and is missing).
+  EditSession(const std::filesystem::path& sceneFile, const PreviewOptions& preview);
+  ~EditSession();
+  EditSession(const EditSession&) = delete;
+  EditSession& operator=(const EditSession&) = delete;
+
+  const Scene& scene() const;
+  const SessionPaths& paths() const;
+  const BrushEngine& engine() const;
+  /// The object's world mesh (for the window's 3D view and picking).
+  const TriangleMesh& worldMesh() const;
+
+  // Painting: the engine's calls; each records the touched region for the next preview
+  // and the unsaved state. Exceptions as in BrushEngine.
+  void beginStroke(const Brush& brush);
+  DabResult addPoints(const std::vector<glm::dvec3>& worldPoints);
+  DabResult addRays(const std::vector<SurfaceRay>& worldRays);
+  StrokeResult endStroke();
+  StrokeResult applyStroke(const Stroke& stroke);
+  std::optional<StrokeResult> undo();
+  std::optional<StrokeResult> redo();
+  bool canUndo() const;
+  bool canRedo() const;
+
+  /// True when the material differs from the last saved (or loaded, or recovered-from)
+  /// state by history position: paint + undo back to the saved stroke is saved again.
+  bool unsaved() const;
+  /// Number of changes (strokes, undos, redos) since the session started; the window
+  /// compares it to decide when the preview and the autosave are stale.
+  std::uint64_t changeCount() const;
+
+  // Preview.
+  void setPreviewCamera(const Camera& camera);  ///< width/height are replaced by the preview size
+  const Camera& previewCamera() const;
+  /// True when a stroke, undo, redo or camera change happened since the last renderPreview.
+  bool previewStale() const;
+  /// Re-renders what changed since the last call: only the touched region is resampled.
+  Image renderPreview(RenderReport* report = nullptr);
+  std::string previewBackendName() const;
+  const LpvSettings& previewSettings() const;
+
+  // Files. Throw InputError/ResourceError with a one-line reason; on failure nothing in
+  // memory changes and the previous files stay intact.
+  void save();
+  /// Writes the current set to `vdbFile` (must end in .vdb); the saved state is unchanged.
+  void exportMaterialSet(const std::filesystem::path& vdbFile) const;
+  /// Writes the recovery file (atomically). Records changeCount() as autosaved.
+  void autosave();
+  /// Unsaved changes that autosave() has not written yet.
+  bool autosaveStale() const;
+  /// Replaces the material with the recovery file's (InputError when it is unreadable or
+  /// does not fit the scene); clears the history; the state counts as unsaved.
+  void recover();
+  /// Deletes the recovery file (after the user declined it, or at a clean exit).
+  void discardRecovery();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sslpv
