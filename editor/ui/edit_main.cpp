@@ -1,0 +1,202 @@
+// sslpv-edit: the editor window (`sslpv edit` runs this program). A separate program so
+// the command-line tool never loads VTK and its X11 dependencies.
+//
+// Scripted use (tests, bug reports): --play replays a vtkInteractorEventRecorder script
+// (StreamVersion 1.1), --screenshot writes the window afterwards, --exit ends the program
+// then instead of waiting for the user; --record writes the user's events as a script.
+#include <vtkInteractorEventRecorder.h>
+#include <vtkPNGWriter.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "editor/edit_session.h"
+#include "editor/ui/edit_input.h"
+#include "editor/ui/edit_window.h"
+#include "volume/atomic_file.h"
+#include "volume/error.h"
+
+namespace {
+
+using namespace sslpv;
+
+constexpr int kExitInput = 2, kExitResource = 3;
+
+struct Options {
+  std::string scene, backend = "cpu", steps, play, record, screenshot, size = "1280x800";
+  std::optional<int> grid;
+  int previewSize = 256;
+  double autosaveSeconds = 5.0;
+  bool recover = false, discardRecovery = false, exitAfter = false;
+};
+
+bool haveDisplay() {
+  const char* display = std::getenv("DISPLAY");
+  return display != nullptr && *display != '\0';
+}
+
+void writeScreenshot(vtkRenderWindow* window, const std::string& file) {
+  window->Render();
+  auto grab = vtkSmartPointer<vtkWindowToImageFilter>::New();
+  grab->SetInput(window);
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  writeAtomically(file, [&](const std::filesystem::path& temp) {
+    auto png = vtkSmartPointer<vtkPNGWriter>::New();
+    png->SetFileName(temp.c_str());
+    png->SetInputConnection(grab->GetOutputPort());
+    png->Write();
+    if (png->GetErrorCode() != 0 || !std::filesystem::exists(temp))
+      throw ResourceError(file + ": could not write the screenshot");
+  });
+}
+
+std::string readText(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot read the event script");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The start-up error in a window, as well as on stderr: someone who launched the editor
+// from a desktop never sees the terminal.
+int showStartupError(const Options& options, const std::string& message, int exitCode) {
+  std::fprintf(stderr, "sslpv edit: %s\n", message.c_str());
+  if (!haveDisplay()) return exitCode;
+  auto window = vtkSmartPointer<vtkRenderWindow>::New();
+  window->SetSize(900, 200);
+  window->SetWindowName("sslpv edit - cannot open the scene");
+  auto renderer = vtkSmartPointer<vtkRenderer>::New();
+  renderer->SetBackground(0.18, 0.05, 0.05);
+  window->AddRenderer(renderer);
+  auto text = vtkSmartPointer<vtkTextActor>::New();
+  text->SetInput(("sslpv edit cannot open the scene:\n" + message + "\n\n(press q to close)").c_str());
+  text->GetTextProperty()->SetFontSize(16);
+  text->SetPosition(20, 40);
+  renderer->AddViewProp(text);
+  auto interactor = vtkSmartPointer<vtkRenderWindowInteractor>::New();
+  interactor->SetRenderWindow(window);
+  interactor->Initialize();
+  window->Render();
+  if (!options.screenshot.empty()) writeScreenshot(window, options.screenshot);
+  if (!options.exitAfter) interactor->Start();
+  return exitCode;
+}
+
+int run(const Options& options) {
+  int width = 0, height = 0;
+  char x = 0;
+  std::istringstream size(options.size);
+  if (!(size >> width >> x >> height) || x != 'x' || width < 320 || height < 240 || width > 8192 || height > 8192)
+    throw InputError("--size: expected WIDTHxHEIGHT of at least 320x240, got '" + options.size + "'");
+  if (options.previewSize < 16 || options.previewSize > 4096)
+    throw InputError("--preview-size: must be between 16 and 4096");
+  if (!(options.autosaveSeconds >= 0.0)) throw InputError("--autosave-seconds: must be >= 0");
+  if (options.recover && options.discardRecovery)
+    throw InputError("--recover and --discard-recovery: choose one");
+  if (!options.screenshot.empty()) requireWritableOutput(options.screenshot);
+  const std::string playScript = options.play.empty() ? std::string() : readText(options.play);
+
+  PreviewOptions preview;
+  preview.backend = options.backend == "vulkan" ? PreviewBackendKind::Vulkan : PreviewBackendKind::Cpu;
+  preview.longestSide = options.previewSize;
+  std::unique_ptr<EditSession> session;
+  try {
+    const LpvSettings sceneLpv = loadScene(options.scene).lpv;
+    preview.lpv = applyLpvFlags(sceneLpv, {options.grid, options.steps, std::nullopt, ""});
+    session = std::make_unique<EditSession>(options.scene, preview);
+  } catch (const InputError& e) {
+    return showStartupError(options, e.what(), kExitInput);
+  }
+  if (!haveDisplay())
+    throw ResourceError("no X display (DISPLAY is not set): the editor needs one; run it under xvfb-run for scripted use");
+
+  if (options.recover) session->recover();
+  if (options.discardRecovery) session->discardRecovery();
+
+  EditWindowOptions windowOptions;
+  windowOptions.width = width;
+  windowOptions.height = height;
+  windowOptions.autosaveSeconds = options.autosaveSeconds;
+  windowOptions.offerRecovery = !options.recover && !options.discardRecovery;
+  EditWindow window(*session, windowOptions);
+  attachEditorInput(window);
+  vtkRenderWindowInteractor* interactor = window.interactor();
+  interactor->Initialize();
+  window.refresh();
+
+  vtkSmartPointer<vtkInteractorEventRecorder> recorder;
+  if (!options.play.empty() || !options.record.empty()) {
+    recorder = vtkSmartPointer<vtkInteractorEventRecorder>::New();
+    recorder->SetInteractor(interactor);
+  }
+  if (!options.play.empty()) {
+    recorder->ReadFromInputStringOn();
+    recorder->SetInputString(playScript.c_str());
+    recorder->Play();
+    window.refresh();
+  }
+  if (!options.screenshot.empty()) writeScreenshot(window.renderWindow(), options.screenshot);
+  if (!options.exitAfter && !window.quitRequested()) {
+    if (!options.record.empty()) {
+      recorder->SetFileName(options.record.c_str());
+      recorder->On();
+      recorder->Record();
+    }
+    interactor->CreateRepeatingTimer(500);
+    interactor->Start();
+    if (recorder) recorder->Stop();
+  }
+  window.onClose();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  CLI::App app{"sslpv edit: paint sigma_t, sigma_s and g into a scene's material set with a live SSLPV preview"};
+  app.add_option("scene", options.scene, "Scene JSON file")->required();
+  app.add_option("--backend", options.backend, "Preview backend: cpu or vulkan")
+      ->check(CLI::IsMember({"cpu", "vulkan"}));
+  app.add_option("--grid", options.grid, "Preview LPV resolution (overrides lpv.resolution)");
+  app.add_option("--steps", options.steps, "Preview propagation steps, or 'auto' (overrides lpv.steps)");
+  app.add_option("--preview-size", options.previewSize, "Longest side of the preview image in pixels");
+  app.add_option("--size", options.size, "Window size WIDTHxHEIGHT");
+  app.add_option("--autosave-seconds", options.autosaveSeconds,
+                 "Write the recovery file this long after the last change (0: after every stroke)");
+  app.add_flag("--recover", options.recover, "Recover unsaved work of an earlier session without asking");
+  app.add_flag("--discard-recovery", options.discardRecovery, "Delete unsaved work of an earlier session");
+  app.add_option("--play", options.play, "Replay a vtkInteractorEventRecorder event script after start-up");
+  app.add_option("--record", options.record, "Record this session's events to a script");
+  app.add_option("--screenshot", options.screenshot, "Write the window as PNG after start-up (and --play)");
+  app.add_flag("--exit", options.exitAfter, "Exit after --play/--screenshot instead of waiting for the user");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "sslpv edit: %s (see sslpv edit --help)\n", e.what());
+    return kExitInput;
+  }
+  try {
+    return run(options);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "sslpv edit: %s\n", e.what());
+    return kExitInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sslpv edit: %s\n", e.what());
+    return kExitResource;
+  }
+}

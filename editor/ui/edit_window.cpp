@@ -1,0 +1,537 @@
+#include "editor/ui/edit_window.h"
+
+#include <vtkActor.h>
+#include <vtkCallbackCommand.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkImageActor.h>
+#include <vtkImageData.h>
+#include <vtkImageMapper3D.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <glm/gtc/matrix_inverse.hpp>
+
+#include "editor/ui/slice_views.h"
+#include "volume/error.h"
+
+namespace sslpv {
+namespace {
+
+// Window layout (normalized viewports): 3D view and preview on top, three slices below.
+constexpr double kSliceRowTop = 0.34;
+constexpr int kSliceSamples = 128;
+
+const char* kHelpText =
+    "sslpv edit - keys\n"
+    "  Space        paint / camera mode (left drag paints in paint mode)\n"
+    "  left drag    3D view: paint on the surface along the view ray\n"
+    "               slice views: paint on the slice plane\n"
+    "  right/middle drag, wheel   camera (3D view); wheel over a slice moves it\n"
+    "  Up / Down    move the slice under the mouse\n"
+    "  c / C        channel: sigma_t, sigma_s, g, albedo+mfp, preset, all\n"
+    "  m / M        mode: set, add, multiply, smooth, erase\n"
+    "  , / .        value down / up (sigma x1.25, g 0.05, mfp x1.25, preset)\n"
+    "  ; / '        albedo down / up (albedo+mfp)\n"
+    "  v            edit all / r / g / b component of the value\n"
+    "  n            negate the add amount\n"
+    "  [ / ]        radius smaller / larger\n"
+    "  - / =        strength down / up\n"
+    "  o            falloff: constant, linear, smooth, gaussian\n"
+    "  x            mirror: off, x, y, z\n"
+    "  i / I        surface depth deeper / shallower\n"
+    "  Ctrl+Z       undo        Ctrl+Y, Ctrl+Shift+Z   redo\n"
+    "  Ctrl+S       save        Ctrl+E   export material set (type a path)\n"
+    "  R / D        recover / discard unsaved work from a previous session\n"
+    "  h, ?, F1     this help   q, e   quit (asks when there are unsaved changes)\n"
+    "  VTK camera keys: r reset, f fly to, w wireframe, s surface, 3 stereo";
+
+vtkSmartPointer<vtkTextActor> makeText(vtkRenderer* renderer, int fontSize, double x, double y) {
+  auto text = vtkSmartPointer<vtkTextActor>::New();
+  text->GetTextProperty()->SetFontSize(fontSize);
+  text->GetTextProperty()->SetFontFamilyToCourier();
+  text->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  text->SetPosition(x, y);
+  renderer->AddViewProp(text);
+  return text;
+}
+
+vtkSmartPointer<vtkPolyData> toPolyData(const TriangleMesh& mesh) {
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetNumberOfPoints(vtkIdType(mesh.positions.size()));
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+    points->SetPoint(vtkIdType(i), mesh.positions[i].x, mesh.positions[i].y, mesh.positions[i].z);
+  auto triangles = vtkSmartPointer<vtkCellArray>::New();
+  for (const glm::uvec3& t : mesh.triangles) {
+    const vtkIdType ids[3] = {vtkIdType(t.x), vtkIdType(t.y), vtkIdType(t.z)};
+    triangles->InsertNextCell(3, ids);
+  }
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  poly->SetPoints(points);
+  poly->SetPolys(triangles);
+  return poly;
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+EditWindow::EditWindow(EditSession& session, const EditWindowOptions& options)
+    : session_(session),
+      options_(options),
+      controls_(session.scene().material.base, glm::length(session.worldMesh().bounds().extent()) / std::sqrt(3.0),
+                session.scene().units) {
+  recoveryPending_ = options.offerRecovery && findRecoveryFile(session.scene().file).has_value();
+  buildScene();
+  updateSlices();
+  updatePreview();
+  updateStatus();
+  if (recoveryPending_) {
+    const std::filesystem::path file = *findRecoveryFile(session.scene().file);
+    showMessage("Unsaved work from an earlier session is in " + file.filename().string() +
+                    ": press R to recover it or D to discard it (painting waits for the answer)",
+                false);
+  }
+}
+
+EditWindow::~EditWindow() = default;
+
+vtkRenderWindow* EditWindow::renderWindow() const { return window_; }
+vtkRenderWindowInteractor* EditWindow::interactor() const { return interactor_; }
+
+void EditWindow::buildScene() {
+  window_ = vtkSmartPointer<vtkRenderWindow>::New();
+  window_->SetSize(options_.width, options_.height);
+  window_->SetNumberOfLayers(2);
+  interactor_ = vtkSmartPointer<vtkRenderWindowInteractor>::New();
+  interactor_->SetRenderWindow(window_);
+
+  view3d_ = vtkSmartPointer<vtkRenderer>::New();
+  view3d_->SetViewport(0.0, kSliceRowTop, 0.5, 1.0);
+  view3d_->SetBackground(0.16, 0.17, 0.2);
+  preview_ = vtkSmartPointer<vtkRenderer>::New();
+  preview_->SetViewport(0.5, kSliceRowTop, 1.0, 1.0);
+  preview_->SetBackground(0.0, 0.0, 0.0);
+  preview_->InteractiveOff();
+  window_->AddRenderer(view3d_);
+  window_->AddRenderer(preview_);
+  std::array<vtkRenderer*, 3> slices{};
+  for (int a = 0; a < 3; ++a) {
+    sliceViews_[a] = vtkSmartPointer<vtkRenderer>::New();
+    // Bottom row; a small gap at the top leaves room for the status line.
+    sliceViews_[a]->SetViewport(a / 3.0, 0.05, (a + 1) / 3.0, kSliceRowTop);
+    window_->AddRenderer(sliceViews_[a]);
+    slices[a] = sliceViews_[a];
+  }
+  // Layer 1 (the overlay) does not clear: every pixel needs a layer-0 renderer under it,
+  // or old text would pile up in the status line.
+  auto statusBar = vtkSmartPointer<vtkRenderer>::New();
+  statusBar->SetViewport(0.0, 0.0, 1.0, 0.05);
+  statusBar->SetBackground(0.0, 0.0, 0.0);
+  statusBar->InteractiveOff();
+  window_->AddRenderer(statusBar);
+  overlay_ = vtkSmartPointer<vtkRenderer>::New();
+  overlay_->SetLayer(1);
+  overlay_->InteractiveOff();
+  overlay_->SetViewport(0.0, 0.0, 1.0, 1.0);
+  window_->AddRenderer(overlay_);
+
+  vtkSmartPointer<vtkPolyData> mesh = toPolyData(session_.worldMesh());
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputData(mesh);
+  meshActor_ = vtkSmartPointer<vtkActor>::New();
+  meshActor_->SetMapper(mapper);
+  // See-through, so the slices inside stay visible while the surface is still pickable.
+  meshActor_->GetProperty()->SetOpacity(0.3);
+  meshActor_->GetProperty()->SetColor(0.85, 0.85, 0.8);
+  view3d_->AddActor(meshActor_);
+  slices_ = std::make_unique<SliceViews>(session_.worldMesh().bounds(), mesh, view3d_, slices, kSliceSamples);
+
+  // The 3D view starts at the scene's camera, which is also the preview's.
+  const Camera& c = session_.scene().camera;
+  vtkCamera* camera = view3d_->GetActiveCamera();
+  camera->SetPosition(c.position.x, c.position.y, c.position.z);
+  camera->SetFocalPoint(c.target.x, c.target.y, c.target.z);
+  camera->SetViewUp(c.up.x, c.up.y, c.up.z);
+  camera->SetViewAngle(c.fovYDeg);
+  view3d_->ResetCameraClippingRange();
+
+  previewImage_ = vtkSmartPointer<vtkImageData>::New();
+  previewActor_ = vtkSmartPointer<vtkImageActor>::New();
+  previewActor_->GetMapper()->SetInputData(previewImage_);
+  preview_->AddViewProp(previewActor_);
+
+  status_ = makeText(overlay_, 13, 0.005, 0.012);
+  message_ = makeText(overlay_, 14, 0.005, 0.965);
+  unsavedMarker_ = makeText(overlay_, 14, 0.005, 0.93);
+  previewLabel_ = makeText(overlay_, 12, 0.505, 0.965);
+  previewLabel_->GetTextProperty()->SetColor(0.8, 0.8, 0.8);
+  help_ = makeText(overlay_, 14, 0.03, 0.12);
+  help_->SetInput(kHelpText);
+  help_->GetTextProperty()->SetBackgroundColor(0.0, 0.0, 0.0);
+  help_->GetTextProperty()->SetBackgroundOpacity(0.85);
+  help_->SetVisibility(false);
+}
+
+void EditWindow::updateSlices() {
+  const Scene& scene = session_.scene();
+  const MaterialField field(scene.material.base, session_.engine().materialSet(),
+                            glm::inverse(scene.transform.matrix()), 1.0 / session_.engine().sigmaToSetUnits());
+  slices_->update(field, controls_.displayChannel(), scene.units);
+}
+
+void EditWindow::updatePreview() {
+  const auto start = std::chrono::steady_clock::now();
+  Image image;
+  try {
+    image = session_.renderPreview();
+  } catch (const std::exception& e) {
+    showMessage(std::string("preview failed: ") + e.what(), true);
+    return;
+  }
+  const double ms = msSince(start);
+  const std::vector<unsigned char> rgb = toDisplayRgb8(image);
+  previewImage_->SetDimensions(image.width, image.height, 1);
+  previewImage_->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  auto* out = static_cast<unsigned char*>(previewImage_->GetScalarPointer());
+  // The renderer's row 0 is the top; VTK's is the bottom.
+  const std::size_t row = std::size_t(image.width) * 3;
+  for (int y = 0; y < image.height; ++y)
+    std::memcpy(out + std::size_t(image.height - 1 - y) * row, rgb.data() + std::size_t(y) * row, row);
+  previewImage_->Modified();
+  preview_->GetActiveCamera()->ParallelProjectionOn();
+  preview_->ResetCamera();
+  // Fill the view's height with the image (ResetCamera leaves a wide margin).
+  preview_->GetActiveCamera()->SetParallelScale(0.5 * image.height);
+  char text[128];
+  std::snprintf(text, sizeof text, "preview %.0f ms", ms);
+  previewTiming_ = text;
+  previewLabel_->SetInput(("SSLPV preview (" + session_.previewBackendName() + ", " +
+                           std::to_string(session_.previewSettings().resolution) + "^3)  " + previewTiming_)
+                              .c_str());
+}
+
+void EditWindow::updateStatus() {
+  status_->SetInput((controls_.describe() + "   | h: help").c_str());
+  const bool unsaved = session_.unsaved();
+  unsavedMarker_->SetInput(unsaved ? "* unsaved changes" : "saved");
+  unsavedMarker_->GetTextProperty()->SetColor(unsaved ? 1.0 : 0.6, unsaved ? 0.6 : 0.6, unsaved ? 0.2 : 0.6);
+  const std::string title = "sslpv edit - " + session_.paths().scene.filename().string() + (unsaved ? " *" : "");
+  window_->SetWindowName(title.c_str());
+}
+
+void EditWindow::showMessage(const std::string& text, bool error) {
+  message_->SetInput(text.c_str());
+  if (error) {
+    message_->GetTextProperty()->SetColor(1.0, 0.3, 0.3);
+    std::fprintf(stderr, "sslpv edit: %s\n", text.c_str());
+  } else {
+    message_->GetTextProperty()->SetColor(0.9, 0.9, 0.9);
+  }
+}
+
+void EditWindow::refresh() {
+  if (session_.previewStale()) updatePreview();
+  updateStatus();
+  window_->Render();
+}
+
+vtkRenderer* EditWindow::rendererAt(int x, int y) const {
+  return interactor_->FindPokedRenderer(x, y);
+}
+
+SurfaceRay EditWindow::rayAt(int x, int y) const {
+  double nearPoint[4], farPoint[4];
+  view3d_->SetDisplayPoint(x, y, 0.0);
+  view3d_->DisplayToWorld();
+  view3d_->GetWorldPoint(nearPoint);
+  view3d_->SetDisplayPoint(x, y, 1.0);
+  view3d_->DisplayToWorld();
+  view3d_->GetWorldPoint(farPoint);
+  glm::dvec3 a(nearPoint[0], nearPoint[1], nearPoint[2]), b(farPoint[0], farPoint[1], farPoint[2]);
+  if (nearPoint[3] != 0.0) a /= nearPoint[3];
+  if (farPoint[3] != 0.0) b /= farPoint[3];
+  // The near plane can sit inside a large object; start at the camera instead.
+  double eye[3];
+  view3d_->GetActiveCamera()->GetPosition(eye);
+  return SurfaceRay{glm::dvec3(eye[0], eye[1], eye[2]), b - a};
+}
+
+bool EditWindow::beginPaint(int x, int y) {
+  if (!controls_.paintMode() || prompt_) return false;
+  vtkRenderer* target = rendererAt(x, y);
+  const std::optional<int> axis = slices_->axisOf(target);
+  if (target != view3d_.Get() && !axis) return false;
+  if (recoveryPending_) {
+    showMessage("Answer the recovery question first: R recovers the earlier session's work, D discards it", true);
+    window_->Render();
+    return true;
+  }
+  try {
+    session_.beginStroke(controls_.brush());
+    paintView_ = axis ? PaintView::Slice : PaintView::Surface;
+    paintAxis_ = axis.value_or(0);
+    continuePaint(x, y);
+  } catch (const std::exception& e) {
+    showMessage(e.what(), true);
+    paintView_ = PaintView::None;
+  }
+  return true;
+}
+
+void EditWindow::continuePaint(int x, int y) {
+  if (paintView_ == PaintView::None) return;
+  try {
+    if (paintView_ == PaintView::Surface)
+      session_.addRays({rayAt(x, y)});
+    else
+      session_.addPoints({slices_->worldPointAt(paintAxis_, x, y)});
+  } catch (const std::exception& e) {
+    showMessage(e.what(), true);
+    endPaint();
+    return;
+  }
+  updateSlices();
+  window_->Render();
+}
+
+void EditWindow::endPaint() {
+  if (paintView_ == PaintView::None) return;
+  paintView_ = PaintView::None;
+  std::optional<StrokeResult> result;
+  try {
+    result = session_.endStroke();
+  } catch (const std::exception& e) {
+    showMessage(e.what(), true);
+  }
+  afterChange(result, "stroke");
+}
+
+void EditWindow::afterChange(const std::optional<StrokeResult>& result, const char* what) {
+  lastChange_ = std::chrono::steady_clock::now();
+  updateSlices();
+  updatePreview();
+  if (result) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%s: %zu voxels changed", what, result->voxelsChanged);
+    showMessage(text, false);
+  }
+  maybeAutosave(true);
+  updateStatus();
+  window_->Render();
+}
+
+void EditWindow::cameraMoved() {
+  vtkCamera* c = view3d_->GetActiveCamera();
+  Camera camera = session_.previewCamera();
+  double v[3];
+  c->GetPosition(v);
+  camera.position = glm::dvec3(v[0], v[1], v[2]);
+  c->GetFocalPoint(v);
+  camera.target = glm::dvec3(v[0], v[1], v[2]);
+  c->GetViewUp(v);
+  camera.up = glm::dvec3(v[0], v[1], v[2]);
+  camera.fovYDeg = c->GetViewAngle();
+  session_.setPreviewCamera(camera);
+  refresh();
+}
+
+bool EditWindow::moveSliceAt(int x, int y, int steps) {
+  const std::optional<int> axis = slices_->axisOf(rendererAt(x, y));
+  if (!axis) return false;
+  slices_->moveSlice(*axis, steps);
+  updateSlices();
+  window_->Render();
+  return true;
+}
+
+void EditWindow::save() {
+  try {
+    session_.save();
+    showMessage("saved " + session_.paths().saveTarget.filename().string(), false);
+  } catch (const std::exception& e) {
+    // The session kept its state and the previous file: say so, keep working.
+    showMessage(std::string("save failed, nothing lost (changes still in memory): ") + e.what(), true);
+  }
+  updateStatus();
+}
+
+void EditWindow::startExportPrompt() {
+  const std::filesystem::path& scene = session_.paths().scene;
+  prompt_ = (scene.parent_path() / (scene.stem().string() + "_export.vdb")).string();
+  showMessage("export to: " + *prompt_ + "_   (Enter writes, Esc cancels)", false);
+}
+
+bool EditWindow::handlePromptKey(const std::string& keySym, char keyCode) {
+  if (keySym == "Escape") {
+    prompt_.reset();
+    showMessage("export cancelled", false);
+  } else if (keySym == "Return" || keySym == "KP_Enter") {
+    const std::string path = *prompt_;
+    prompt_.reset();
+    try {
+      session_.exportMaterialSet(path);
+      showMessage("exported material set to " + path, false);
+    } catch (const std::exception& e) {
+      showMessage(std::string("export failed: ") + e.what(), true);
+    }
+  } else {
+    if (keySym == "BackSpace") {
+      if (!prompt_->empty()) prompt_->pop_back();
+    } else if (keyCode >= 32 && keyCode < 127) {
+      prompt_->push_back(keyCode);
+    }
+    showMessage("export to: " + *prompt_ + "_   (Enter writes, Esc cancels)", false);
+  }
+  return true;
+}
+
+bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char keyCode) {
+  if (prompt_) {
+    handlePromptKey(key, keyCode);
+    window_->Render();
+    return true;
+  }
+  if (key != "q" && key != "e") quitArmed_ = false;
+  const std::string lower = key.size() == 1 ? std::string(1, char(std::tolower(key[0]))) : key;
+  bool handled = true;
+  if (ctrl) {
+    if (lower == "z" && !shift) {
+      afterChange(session_.undo(), "undo");
+    } else if ((lower == "z" && shift) || lower == "y") {
+      afterChange(session_.redo(), "redo");
+    } else if (lower == "s") {
+      save();
+    } else if (lower == "e") {
+      startExportPrompt();
+    } else {
+      handled = false;
+    }
+  } else if (recoveryPending_ && key == "R") {
+    try {
+      session_.recover();
+      recoveryPending_ = false;
+      showMessage("recovered the earlier session's work (not saved yet: Ctrl+S saves it)", false);
+      afterChange(std::nullopt, "recover");
+    } catch (const std::exception& e) {
+      showMessage(std::string("recovery failed: ") + e.what(), true);
+    }
+  } else if (recoveryPending_ && key == "D") {
+    try {
+      session_.discardRecovery();
+      recoveryPending_ = false;
+      showMessage("discarded the earlier session's unsaved work", false);
+    } catch (const std::exception& e) {
+      showMessage(std::string("could not delete the recovery file: ") + e.what(), true);
+    }
+  } else if (key == "space") {
+    controls_.setPaintMode(!controls_.paintMode());
+  } else if (lower == "c") {
+    controls_.cycleChannel(shift ? -1 : 1);
+    updateSlices();
+  } else if (lower == "m") {
+    controls_.cycleMode(shift ? -1 : 1);
+  } else if (key == "o") {
+    controls_.cycleFalloff();
+  } else if (key == "comma" || key == "period") {
+    controls_.adjustValue(key == "period" ? 1 : -1);
+  } else if (key == "semicolon" || key == "apostrophe") {
+    controls_.adjustAlbedo(key == "apostrophe" ? 1 : -1);
+  } else if (key == "v") {
+    controls_.cycleComponent();
+  } else if (key == "n") {
+    controls_.negateValue();
+  } else if (key == "bracketleft" || key == "bracketright") {
+    controls_.scaleRadius(key == "bracketright" ? 1.2 : 1.0 / 1.2);
+  } else if (key == "minus" || key == "equal" || key == "plus") {
+    controls_.adjustStrength(key == "minus" ? -0.05 : 0.05);
+  } else if (key == "x") {
+    controls_.cycleMirror();
+  } else if (lower == "i") {
+    controls_.adjustDepth(shift ? -1 : 1);
+  } else if (key == "h" || key == "question" || key == "F1") {
+    helpVisible_ = !helpVisible_;
+    help_->SetVisibility(helpVisible_);
+  } else if (key == "Escape") {
+    helpVisible_ = false;
+    help_->SetVisibility(false);
+    showMessage("", false);
+  } else if (key == "q" || key == "e") {
+    if (session_.unsaved() && !quitArmed_) {
+      quitArmed_ = true;
+      showMessage("Unsaved changes: Ctrl+S saves them; press " + key + " again to quit without saving", true);
+    } else {
+      quit_ = true;
+    }
+  } else {
+    handled = false;
+  }
+  if (handled) {
+    updateStatus();
+    window_->Render();
+  }
+  return handled;
+}
+
+void EditWindow::maybeAutosave(bool strokeJustEnded) {
+  if (recoveryPending_ || !session_.autosaveStale()) return;
+  const double idleSeconds = msSince(lastChange_) / 1000.0;
+  if (!(options_.autosaveSeconds <= 0.0 && strokeJustEnded) && idleSeconds < options_.autosaveSeconds) return;
+  try {
+    session_.autosave();
+  } catch (const std::exception& e) {
+    showMessage(std::string("autosave failed: ") + e.what(), true);
+  }
+}
+
+void EditWindow::onTimer() {
+  if (painting()) return;
+  maybeAutosave(false);
+}
+
+void EditWindow::onClose() {
+  if (quit_ && quitArmed_) {
+    // The user chose to quit without saving: the recovery file would only resurrect it.
+    try {
+      session_.discardRecovery();
+    } catch (const std::exception&) {
+    }
+    return;
+  }
+  if (!session_.unsaved() && !recoveryPending_) {
+    // Saved (or undone back to the saved state): an older recovery file would only offer
+    // to bring back something the user walked away from.
+    try {
+      session_.discardRecovery();
+    } catch (const std::exception&) {
+    }
+    return;
+  }
+  if (session_.unsaved() && !recoveryPending_) {
+    try {
+      session_.autosave();
+      std::fprintf(stderr, "sslpv edit: unsaved changes kept in %s; the next `sslpv edit %s` offers to recover them\n",
+                   session_.paths().recovery.string().c_str(), session_.paths().scene.string().c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "sslpv edit: could not keep the unsaved changes: %s\n", e.what());
+    }
+  }
+}
+
+}  // namespace sslpv

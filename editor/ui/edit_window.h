@@ -1,0 +1,105 @@
+#pragma once
+// The editor's VTK window: a 3D view of the object with the slices inside it (trackball
+// camera), the live SSLPV preview seen through the 3D view's camera, three 2D slice views
+// with a colour legend, a status line, messages and a help overlay. Painting, keys and
+// files go through EditSession; this class only maps input to it and shows its state.
+#include <vtkSmartPointer.h>
+
+#include <array>
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "editor/brush_controls.h"
+#include "editor/edit_session.h"
+
+class vtkActor;
+class vtkImageActor;
+class vtkImageData;
+class vtkRenderWindow;
+class vtkRenderWindowInteractor;
+class vtkRenderer;
+class vtkTextActor;
+
+namespace sslpv {
+
+class SliceViews;
+
+struct EditWindowOptions {
+  int width = 1280, height = 800;
+  double autosaveSeconds = 5.0;  ///< after the last change; 0: after every stroke
+  bool offerRecovery = true;     ///< false when --recover/--discard-recovery answered already
+};
+
+class EditWindow {
+ public:
+  EditWindow(EditSession& session, const EditWindowOptions& options);
+  ~EditWindow();
+
+  vtkRenderWindow* renderWindow() const;
+  vtkRenderWindowInteractor* interactor() const;
+  /// Shows a one-line message (errors in red) until the next message or key press.
+  void showMessage(const std::string& text, bool error);
+  /// Re-renders the preview if stale and redraws everything.
+  void refresh();
+  /// True once the user asked to quit (q / e), after any unsaved-work confirmation.
+  bool quitRequested() const { return quit_; }
+  /// The window is closing (window manager or quit): keeps unsaved work in the recovery file.
+  void onClose();
+
+  // Input, called by the interactor style (editor/ui/edit_input.cpp).
+  bool handleKey(const std::string& keySym, bool ctrl, bool shift, char keyCode);
+  /// Starts a stroke at display (x, y) if paint mode is on and a paintable view is under it.
+  bool beginPaint(int x, int y);
+  void continuePaint(int x, int y);
+  void endPaint();
+  bool painting() const { return paintView_ != PaintView::None; }
+  bool is3dView(const vtkRenderer* renderer) const { return renderer != nullptr && renderer == view3d_.Get(); }
+  /// The 3D view's camera moved: the preview follows it.
+  void cameraMoved();
+  void onTimer();
+  /// Moves the slice of the view under (x, y) by `steps` samples; false if none there.
+  bool moveSliceAt(int x, int y, int steps);
+
+ private:
+  enum class PaintView { None, Surface, Slice };
+  void buildScene();
+  void updateSlices();
+  void updatePreview();
+  void updateStatus();
+  void afterChange(const std::optional<StrokeResult>& result, const char* what);
+  void save();
+  void startExportPrompt();
+  bool handlePromptKey(const std::string& keySym, char keyCode);
+  void maybeAutosave(bool strokeJustEnded);
+  SurfaceRay rayAt(int x, int y) const;
+  vtkRenderer* rendererAt(int x, int y) const;
+
+  EditSession& session_;
+  EditWindowOptions options_;
+  BrushControls controls_;
+  std::unique_ptr<SliceViews> slices_;
+
+  vtkSmartPointer<vtkRenderWindow> window_;
+  vtkSmartPointer<vtkRenderWindowInteractor> interactor_;
+  vtkSmartPointer<vtkRenderer> view3d_, preview_, overlay_;
+  std::array<vtkSmartPointer<vtkRenderer>, 3> sliceViews_;
+  vtkSmartPointer<vtkActor> meshActor_;
+  vtkSmartPointer<vtkImageData> previewImage_;
+  vtkSmartPointer<vtkImageActor> previewActor_;
+  vtkSmartPointer<vtkTextActor> status_, message_, help_, unsavedMarker_, previewLabel_;
+
+  PaintView paintView_ = PaintView::None;
+  int paintAxis_ = 0;
+  bool helpVisible_ = false;
+  bool quit_ = false;
+  bool quitArmed_ = false;
+  bool recoveryPending_ = false;
+  std::optional<std::string> prompt_;  ///< export path being typed
+  std::chrono::steady_clock::time_point lastChange_;
+  std::string previewTiming_;
+};
+
+}  // namespace sslpv
