@@ -209,7 +209,7 @@ TEST(ExitGain, AnAbsorbingCellInABrightMediumTakesItsNeighboursGain) {
   // 0.95): its own gain is far larger (it corrects light injected in that cell, which the
   // lattice holds too shallow), but most of the light it holds diffused in from the bright
   // neighbours; with its own gain that light would glow. It takes the smallest gain among
-  // itself and its face neighbours; the neighbours keep their own (smaller) gain.
+  // the cells within two cells of it; the neighbours keep their own (smaller) gain.
   MaterialGrid m = test::uniformMaterial(7, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
   const std::size_t spot = m.frame.index(3, 3, 3);
   m.sigmaT[spot] = glm::vec3(8.0f);
@@ -223,6 +223,30 @@ TEST(ExitGain, AnAbsorbingCellInABrightMediumTakesItsNeighboursGain) {
   // The seed scheme has no gain at all.
   const StepFactors seed = computeStepFactors(m, LpvScheme::Seed, 1.0);
   EXPECT_EQ(seed.exitGain[0][spot], 1.0f);
+}
+
+TEST(ExitGain, ALargeAbsorbingRegionKeepsItsOwnGainInside) {
+  // The limit reaches two cells: the centre of a 3-cell-wide absorbing block takes the
+  // bright surroundings' gain, the centre of a 7-cell-wide block (four cells from the
+  // bright medium) keeps its own, so large uniformly painted regions stay calibrated.
+  MaterialGrid m = test::uniformMaterial(13, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
+  for (int z = 3; z <= 9; ++z)
+    for (int y = 3; y <= 9; ++y)
+      for (int x = 3; x <= 9; ++x) m.sigmaT[m.frame.index(x, y, z)] = glm::vec3(8.0f);
+  const float dark = calibratedTransport(8.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
+  const float bright = calibratedTransport(2.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
+  StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.0);
+  EXPECT_EQ(f.exitGain[1][m.frame.index(6, 6, 6)], dark);
+  EXPECT_EQ(f.exitGain[1][m.frame.index(5, 6, 6)], dark);   // three cells from the bright medium
+  EXPECT_EQ(f.exitGain[1][m.frame.index(4, 6, 6)], bright);  // two cells
+  EXPECT_EQ(f.exitGain[1][m.frame.index(4, 4, 4)], bright);  // two cells along the diagonal
+
+  MaterialGrid small = test::uniformMaterial(13, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
+  for (int z = 5; z <= 7; ++z)
+    for (int y = 5; y <= 7; ++y)
+      for (int x = 5; x <= 7; ++x) small.sigmaT[small.frame.index(x, y, z)] = glm::vec3(8.0f);
+  f = computeStepFactors(small, LpvScheme::Calibrated, 1.0);
+  EXPECT_EQ(f.exitGain[1][small.frame.index(6, 6, 6)], bright);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <xmmintrin.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 
 #include "volume/lpv_stages.h"
@@ -189,32 +190,40 @@ glm::dvec3 gridPower(const ShGrid& grid) {
 // The calibrated exit gain maps a homogeneous medium's lattice reflectance to the true
 // one; it grows like 1/r (r = exp(-σtr Δx)) as a cell gets more absorbing, because there
 // the lattice's first cell holds far less light than the medium's first transport length.
-// That holds for light injected in the cell itself. A strongly absorbing cell painted into
-// a bright medium also receives light diffusing in from its neighbours, and its large gain
-// would turn that into a glow where the artist painted a dark spot. Each cell therefore
-// uses the smallest gain of itself and its active face neighbours: unchanged inside any
-// homogeneous region (all gains equal), the neighbours' gain at a material boundary.
+// That holds for light injected in the cell itself. A strongly absorbing spot painted into
+// a bright medium also receives light diffusing in from its bright surroundings (damped
+// by about 6r per cell it crosses), and its large gain would turn that into a glow where
+// the artist painted a dark spot. Each cell therefore uses the smallest gain among the
+// active cells within kExitGainReach cells (a cube): unchanged inside any homogeneous
+// region (all gains equal), the surroundings' gain in spots up to twice that wide.
+constexpr int kExitGainReach = 2;
+
 void limitExitGainToNeighbours(const MaterialGrid& material, StepFactors& factors) {
   const GridFrame& f = material.frame;
+  const float inactive = std::numeric_limits<float>::infinity();
   for (int ch = 0; ch < 3; ++ch) {
-    const std::vector<float> own = factors.exitGain[ch];
-    std::vector<float>& gain = factors.exitGain[ch];
-    tbb::parallel_for(0, f.dims.z, [&](int z) {
-      for (int y = 0; y < f.dims.y; ++y)
-        for (int x = 0; x < f.dims.x; ++x) {
-          const std::size_t i = f.index(x, y, z);
-          if (!factors.active[i]) continue;
-          float smallest = own[i];
-          const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
-          for (const auto& o : offsets) {
-            const int nx = x + o[0], ny = y + o[1], nz = z + o[2];
-            if (nx < 0 || ny < 0 || nz < 0 || nx >= f.dims.x || ny >= f.dims.y || nz >= f.dims.z) continue;
-            const std::size_t j = f.index(nx, ny, nz);
-            if (factors.active[j]) smallest = std::min(smallest, own[j]);
+    // A cube minimum is three 1D minima; inactive cells enter as +inf.
+    std::vector<float> current(factors.exitGain[ch].size());
+    for (std::size_t i = 0; i < current.size(); ++i) current[i] = factors.active[i] ? factors.exitGain[ch][i] : inactive;
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::vector<float> previous = current;
+      tbb::parallel_for(0, f.dims.z, [&](int z) {
+        for (int y = 0; y < f.dims.y; ++y)
+          for (int x = 0; x < f.dims.x; ++x) {
+            const glm::ivec3 cell(x, y, z);
+            float smallest = inactive;
+            for (int d = -kExitGainReach; d <= kExitGainReach; ++d) {
+              glm::ivec3 other = cell;
+              other[axis] += d;
+              if (other[axis] < 0 || other[axis] >= f.dims[axis]) continue;
+              smallest = std::min(smallest, previous[f.index(other.x, other.y, other.z)]);
+            }
+            current[f.index(x, y, z)] = smallest;
           }
-          gain[i] = smallest;
-        }
-    });
+      });
+    }
+    for (std::size_t i = 0; i < current.size(); ++i)
+      if (factors.active[i]) factors.exitGain[ch][i] = current[i];
   }
 }
 
