@@ -222,7 +222,11 @@ void EditWindow::updatePreview() {
   char text[128];
   std::snprintf(text, sizeof text, "preview %.0f ms", ms);
   previewTiming_ = text;
-  previewLabel_->SetInput(("SSLPV preview (" + session_.previewBackendName() + ", " +
+  // "vulkan (llvmpipe (LLVM 15.0.6, 256 bits))" would run off the view: keep the device.
+  std::string backend = session_.previewBackendName();
+  if (const std::size_t inner = backend.find(" (", backend.find('(') + 1); inner != std::string::npos)
+    backend = backend.substr(0, inner) + ")";
+  previewLabel_->SetInput(("SSLPV preview (" + backend + ", " +
                            std::to_string(session_.previewSettings().resolution) + "^3)  " + previewTiming_)
                               .c_str());
 }
