@@ -209,7 +209,7 @@ TEST(ExitGain, AnAbsorbingCellInABrightMediumTakesItsNeighboursGain) {
   // 0.95): its own gain is far larger (it corrects light injected in that cell, which the
   // lattice holds too shallow), but most of the light it holds diffused in from the bright
   // neighbours; with its own gain that light would glow. It takes the smallest gain among
-  // the cells within two cells of it; the neighbours keep their own (smaller) gain.
+  // the brighter cells up to two cells away along the axes; the neighbours keep their own.
   MaterialGrid m = test::uniformMaterial(7, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
   const std::size_t spot = m.frame.index(3, 3, 3);
   m.sigmaT[spot] = glm::vec3(8.0f);
@@ -239,7 +239,7 @@ TEST(ExitGain, ALargeAbsorbingRegionKeepsItsOwnGainInside) {
   EXPECT_EQ(f.exitGain[1][m.frame.index(6, 6, 6)], dark);
   EXPECT_EQ(f.exitGain[1][m.frame.index(5, 6, 6)], dark);   // three cells from the bright medium
   EXPECT_EQ(f.exitGain[1][m.frame.index(4, 6, 6)], bright);  // two cells
-  EXPECT_EQ(f.exitGain[1][m.frame.index(4, 4, 4)], bright);  // two cells along the diagonal
+  EXPECT_EQ(f.exitGain[1][m.frame.index(4, 4, 4)], bright);  // two cells along each axis
 
   MaterialGrid small = test::uniformMaterial(13, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
   for (int z = 5; z <= 7; ++z)
@@ -247,6 +247,25 @@ TEST(ExitGain, ALargeAbsorbingRegionKeepsItsOwnGainInside) {
       for (int x = 5; x <= 7; ++x) small.sigmaT[small.frame.index(x, y, z)] = glm::vec3(8.0f);
   f = computeStepFactors(small, LpvScheme::Calibrated, 1.0);
   EXPECT_EQ(f.exitGain[1][small.frame.index(6, 6, 6)], bright);
+}
+
+TEST(ExitGain, ABrighterCellNeverTakesADarkerNeighboursGain) {
+  // Light diffuses from bright media into dark ones, not the other way in quantity: a
+  // high-albedo cell next to a lower-albedo medium with a smaller gain keeps its own gain
+  // (taking the neighbour's would draw a coloured fringe along every painted boundary).
+  MaterialGrid m = test::uniformMaterial(9, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
+  for (int z = 1; z <= 7; ++z)
+    for (int y = 1; y <= 7; ++y)
+      for (int x = 5; x <= 7; ++x) {
+        m.sigmaT[m.frame.index(x, y, z)] = glm::vec3(0.05f);
+        m.sigmaS[m.frame.index(x, y, z)] = glm::vec3(0.03f);
+      }
+  const float brightOwn = calibratedTransport(2.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
+  const float thinOwn = calibratedTransport(0.05f, 0.03f, 0.0, 1.0, 1.0).exitGain;
+  ASSERT_LT(thinOwn, brightOwn) << "the premise: the thin, darker medium has the smaller gain";
+  const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.0);
+  EXPECT_EQ(f.exitGain[0][m.frame.index(4, 4, 4)], brightOwn);
+  EXPECT_EQ(f.exitGain[0][m.frame.index(5, 4, 4)], thinOwn);
 }
 
 }  // namespace

@@ -191,39 +191,44 @@ glm::dvec3 gridPower(const ShGrid& grid) {
 // one; it grows like 1/r (r = exp(-σtr Δx)) as a cell gets more absorbing, because there
 // the lattice's first cell holds far less light than the medium's first transport length.
 // That holds for light injected in the cell itself. A strongly absorbing spot painted into
-// a bright medium also receives light diffusing in from its bright surroundings (damped
-// by about 6r per cell it crosses), and its large gain would turn that into a glow where
-// the artist painted a dark spot. Each cell therefore uses the smallest gain among the
-// active cells within kExitGainReach cells (a cube): unchanged inside any homogeneous
-// region (all gains equal), the surroundings' gain in spots up to twice that wide.
+// a bright medium also receives light diffusing in from its brighter surroundings, and its
+// large gain would turn that into a glow where the artist painted a dark spot. So a cell
+// uses the smallest gain among itself and the cells up to kExitGainReach cells away along
+// the axes whose reduced albedo (this channel) is at least its own: the media its light
+// can have come from in quantity. Inside a homogeneous region nothing changes (all gains
+// equal); a brighter cell never takes a darker neighbour's gain (no fringes between
+// painted media).
 constexpr int kExitGainReach = 2;
 
 void limitExitGainToNeighbours(const MaterialGrid& material, StepFactors& factors) {
   const GridFrame& f = material.frame;
-  const float inactive = std::numeric_limits<float>::infinity();
+  const std::size_t n = f.cellCount();
   for (int ch = 0; ch < 3; ++ch) {
-    // A cube minimum is three 1D minima; inactive cells enter as +inf.
-    std::vector<float> current(factors.exitGain[ch].size());
-    for (std::size_t i = 0; i < current.size(); ++i) current[i] = factors.active[i] ? factors.exitGain[ch][i] : inactive;
-    for (int axis = 0; axis < 3; ++axis) {
-      const std::vector<float> previous = current;
-      tbb::parallel_for(0, f.dims.z, [&](int z) {
-        for (int y = 0; y < f.dims.y; ++y)
-          for (int x = 0; x < f.dims.x; ++x) {
-            const glm::ivec3 cell(x, y, z);
-            float smallest = inactive;
-            for (int d = -kExitGainReach; d <= kExitGainReach; ++d) {
-              glm::ivec3 other = cell;
-              other[axis] += d;
-              if (other[axis] < 0 || other[axis] >= f.dims[axis]) continue;
-              smallest = std::min(smallest, previous[f.index(other.x, other.y, other.z)]);
-            }
-            current[f.index(x, y, z)] = smallest;
-          }
-      });
+    std::vector<float> albedo(n, 0.0f);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!factors.active[i]) continue;
+      const double g = material.g[i], sigmaS = material.sigmaS[i][ch], sigmaT = material.sigmaT[i][ch];
+      const double reducedT = sigmaT - sigmaS * g;
+      albedo[i] = reducedT > 0.0 ? float(sigmaS * (1.0 - g) / reducedT) : 0.0f;
     }
-    for (std::size_t i = 0; i < current.size(); ++i)
-      if (factors.active[i]) factors.exitGain[ch][i] = current[i];
+    const std::vector<float> own = factors.exitGain[ch];
+    tbb::parallel_for(0, f.dims.z, [&](int z) {
+      for (int y = 0; y < f.dims.y; ++y)
+        for (int x = 0; x < f.dims.x; ++x) {
+          const std::size_t i = f.index(x, y, z);
+          if (!factors.active[i]) continue;
+          float smallest = own[i];
+          for (int axis = 0; axis < 3; ++axis)
+            for (int d = -kExitGainReach; d <= kExitGainReach; ++d) {
+              glm::ivec3 other(x, y, z);
+              other[axis] += d;
+              if (d == 0 || other[axis] < 0 || other[axis] >= f.dims[axis]) continue;
+              const std::size_t j = f.index(other.x, other.y, other.z);
+              if (factors.active[j] && albedo[j] >= albedo[i]) smallest = std::min(smallest, own[j]);
+            }
+          factors.exitGain[ch][i] = smallest;
+        }
+    });
   }
 }
 
