@@ -12,37 +12,13 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "volume/fresnel.h"
+#include "volume/quadrature.h"
 
 namespace sslpv {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-/// Gauss–Legendre nodes and weights on [0, 1].
-void gaussLegendre01(int n, std::vector<double>& x, std::vector<double>& w) {
-  x.resize(std::size_t(n));
-  w.resize(std::size_t(n));
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5));
-    double derivative = 1.0;
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      double p0 = 1.0, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      derivative = n * (z * p1 - p0) / (z * z - 1.0);
-      const double dz = p1 / derivative;
-      z -= dz;
-      if (std::abs(dz) < 1e-16) break;
-    }
-    x[std::size_t(i)] = 0.5 * (1.0 - z);
-    w[std::size_t(i)] = 1.0 / ((1.0 - z * z) * derivative * derivative);
-  }
-}
 
 /// Fresnel reflectance of light inside the medium arriving at the boundary with direction
 /// cosine mu: 1 beyond the critical angle, else that of the refracted pair (reciprocity).
@@ -57,24 +33,25 @@ double internalFresnel(double mu, double eta) {
 /// and Gauss in s on μ = μc + (1 - μc) s² (see the header).
 void boundaryQuadrature(int n, double eta, std::vector<double>& mu, std::vector<double>& weight) {
   if (eta <= 1.0) {
-    gaussLegendre01(n, mu, weight);
+    Quadrature q = gaussLegendreUnit(n);
+    mu = std::move(q.x);
+    weight = std::move(q.w);
     return;
   }
   const double muC = std::sqrt(1.0 - 1.0 / (eta * eta));
   const int lower = n / 2, upper = n - lower;
-  std::vector<double> x, w;
   mu.clear();
   weight.clear();
-  gaussLegendre01(lower, x, w);
+  const Quadrature below = gaussLegendreUnit(lower);
   for (int i = 0; i < lower; ++i) {
-    mu.push_back(muC * x[std::size_t(i)]);
-    weight.push_back(muC * w[std::size_t(i)]);
+    mu.push_back(muC * below.x[std::size_t(i)]);
+    weight.push_back(muC * below.w[std::size_t(i)]);
   }
-  gaussLegendre01(upper, x, w);
+  const Quadrature above = gaussLegendreUnit(upper);
   for (int i = 0; i < upper; ++i) {
-    const double s = x[std::size_t(i)];
+    const double s = above.x[std::size_t(i)];
     mu.push_back(muC + (1.0 - muC) * s * s);
-    weight.push_back((1.0 - muC) * 2.0 * s * w[std::size_t(i)]);
+    weight.push_back((1.0 - muC) * 2.0 * s * above.w[std::size_t(i)]);
   }
 }
 

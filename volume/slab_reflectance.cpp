@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "volume/quadrature.h"
 #include "volume/reference_tracer.h"
 #include "volume/scene.h"
 
@@ -17,36 +18,6 @@ namespace sslpv {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-/// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n, Golub–Welsch not needed).
-struct Quadrature {
-  std::vector<double> x, w;
-};
-
-Quadrature gaussLegendre01(int n) {
-  Quadrature q;
-  q.x.resize(std::size_t(n));
-  q.w.resize(std::size_t(n));
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5));
-    double derivative = 1.0;
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      double p0 = 1.0, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      derivative = n * (z * p1 - p0) / (z * z - 1.0);
-      const double dz = p1 / derivative;
-      z -= dz;
-      if (std::abs(dz) < 1e-16) break;
-    }
-    q.x[std::size_t(i)] = 0.5 * (1.0 - z);
-    q.w[std::size_t(i)] = 1.0 / ((1.0 - z * z) * derivative * derivative);  // 2/(..) on [-1,1], halved
-  }
-  return q;
-}
 
 }  // namespace
 
@@ -64,7 +35,7 @@ double chandrasekharH(double mu, double albedo) {
   // equivalent to H(μ) = 1 / (1 - (ω/2) μ ∫0^1 H(μ') / (μ + μ') dμ') but contracting
   // fast even near ω = 1, where the plain form converges slowly. Solved on the quadrature
   // nodes (Nyström), then evaluated at μ with the same quadrature.
-  static const Quadrature q = gaussLegendre01(96);
+  static const Quadrature q = gaussLegendreUnit(96);
   const std::size_t n = q.x.size();
   const double root = std::sqrt(1.0 - albedo);
   std::vector<double> h(n, 1.0), next(n);
