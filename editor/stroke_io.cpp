@@ -1,17 +1,13 @@
 // Stroke files (format in stroke_io.h): strict parsing with key paths in every message.
 #include "editor/stroke_io.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
-#include <set>
-#include <string_view>
 #include <utility>
 
 #include "volume/error.h"
+#include "volume/strict_json.h"
 
 namespace sslpv {
 namespace {
@@ -19,167 +15,11 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Keys and strings are echoed into one-line messages: control characters must not break it.
-std::string printable(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-std::string childPath(const std::string& path, std::string_view key) {
-  return path.empty() ? printable(key) : path + "." + printable(key);
-}
-std::string indexPath(const std::string& path, std::size_t index) { return path + "[" + std::to_string(index) + "]"; }
-
-std::string formatNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", value);
-  return text;
-}
-
-std::string describeType(const json& value) {
-  switch (value.type()) {
-    case json::value_t::null:
-      return "null";
-    case json::value_t::object:
-      return "an object";
-    case json::value_t::array:
-      return "an array";
-    case json::value_t::string:
-      return "a string";
-    case json::value_t::boolean:
-      return "a boolean";
-    case json::value_t::binary:
-      return "binary data";
-    case json::value_t::discarded:
-      return "nothing";
-    default:
-      return "a number";
-  }
-}
-
-std::string quotedList(std::initializer_list<const char*> names) {
-  std::string out;
-  for (const char* name : names) out += std::string(out.empty() ? "" : ", ") + "\"" + name + "\"";
-  return out;
-}
-
-/// Follows the parser through the document, so that a syntax error (NaN, a stray token) and
-/// a duplicated key can be reported at the key path where they occur.
-class PathTracker {
+/// The stroke file's own value kinds on top of the strict reader.
+class Reader : public StrictJsonReader {
  public:
-  explicit PathTracker(const fs::path& file) : file_(file) {}
-  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-        frames_->push_back({false, 0, {}, false, {}});
-        break;
-      case json::parse_event_t::array_start:
-        frames_->push_back({true, 0, {}, false, {}});
-        break;
-      case json::parse_event_t::key: {
-        Frame& top = frames_->back();
-        top.key = parsed.get<std::string>();
-        top.hasKey = true;
-        if (!top.keys.insert(top.key).second) throw InputError(file_.string() + ": " + path() + ": duplicate key");
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames_->pop_back();
-        completeValue();
-        break;
-      case json::parse_event_t::value:
-        completeValue();
-        break;
-    }
-    return true;
-  }
-  /// The key path of the value being parsed.
-  std::string path() const {
-    std::string out;
-    for (const Frame& f : *frames_) {
-      if (f.isArray)
-        out = indexPath(out, f.index);
-      else if (f.hasKey)
-        out = childPath(out, f.key);
-    }
-    return out;
-  }
+  using StrictJsonReader::StrictJsonReader;
 
- private:
-  struct Frame {
-    bool isArray;
-    std::size_t index;
-    std::string key;
-    bool hasKey;
-    std::set<std::string> keys;
-  };
-  void completeValue() {
-    if (frames_->empty()) return;
-    Frame& top = frames_->back();
-    if (top.isArray)
-      ++top.index;
-    else
-      top.hasKey = false;
-  }
-  const fs::path& file_;
-  // Shared: nlohmann copies the callback, the caller keeps a copy to ask for the path.
-  std::shared_ptr<std::vector<Frame>> frames_ = std::make_shared<std::vector<Frame>>();
-};
-
-class Reader {
- public:
-  explicit Reader(const fs::path& file) : file_(file) {}
-
-  [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
-    throw InputError(file_.string() + ": " + (path.empty() ? "" : path + ": ") + reason);
-  }
-  void requireObject(const json& v, const std::string& path) const {
-    if (!v.is_object()) fail(path, "expected an object, got " + describeType(v));
-  }
-  void allowOnly(const json& object, const std::string& path, std::initializer_list<const char*> accepted) const {
-    for (const auto& item : object.items()) {
-      bool known = false;
-      for (const char* name : accepted) known = known || item.key() == name;
-      if (!known) fail(childPath(path, item.key()), "unknown key (accepted keys: " + quotedList(accepted) + ")");
-    }
-  }
-  const json* optional(const json& object, const char* key) const {
-    auto it = object.find(key);
-    return it == object.end() ? nullptr : &*it;
-  }
-  const json& required(const json& object, const std::string& path, const char* key) const {
-    auto it = object.find(key);
-    if (it == object.end()) fail(path, std::string("missing required key \"") + key + "\"");
-    return *it;
-  }
-  double number(const json& v, const std::string& path) const {
-    if (!v.is_number()) fail(path, "expected a number, got " + describeType(v));
-    const double result = v.get<double>();
-    if (!std::isfinite(result)) fail(path, "expected a finite number");
-    return result;
-  }
-  std::string string(const json& v, const std::string& path) const {
-    if (!v.is_string()) fail(path, "expected a string, got " + describeType(v));
-    return v.get<std::string>();
-  }
-  glm::dvec3 vec3(const json& v, const std::string& path) const {
-    if (!v.is_array() || v.size() != 3)
-      fail(path, "expected an array of 3 numbers, got " +
-                     (v.is_array() ? "an array of " + std::to_string(v.size()) : describeType(v)));
-    glm::dvec3 result;
-    for (std::size_t i = 0; i < 3; ++i) result[int(i)] = number(v[i], indexPath(path, i));
-    return result;
-  }
   /// [r,g,b] or one number for all three channels, each in [lo, hi].
   glm::dvec3 rgb(const json& v, const std::string& path, double lo, double hi, const char* range) const {
     if (v.is_number()) {
@@ -188,26 +28,12 @@ class Reader {
       return glm::dvec3(x);
     }
     if (!v.is_array()) fail(path, "expected a number or an array of 3 numbers, got " + describeType(v));
-    const glm::dvec3 result = vec3(v, path);
+    const glm::dvec3 result = vec3OfNumbers(v, path);
     for (int i = 0; i < 3; ++i)
       if (!(result[i] >= lo && result[i] <= hi))
         fail(indexPath(path, std::size_t(i)), std::string("must be ") + range + ", got " + formatNumber(result[i]));
     return result;
   }
-  template <class Enum>
-  Enum choice(const json& v, const std::string& path, const char* what,
-              std::initializer_list<std::pair<const char*, Enum>> options) const {
-    const std::string text = string(v, path);
-    std::string accepted;
-    for (const auto& [name, value] : options) {
-      if (text == name) return value;
-      accepted += std::string(accepted.empty() ? "" : ", ") + "\"" + name + "\"";
-    }
-    fail(path, "unknown " + std::string(what) + " \"" + printable(text) + "\" (accepted: " + accepted + ")");
-  }
-
- private:
-  const fs::path& file_;
 };
 
 constexpr double kInf = HUGE_VAL;
@@ -318,7 +144,8 @@ Stroke parseStroke(const Reader& in, const json& node, const std::string& path) 
     const std::string p = childPath(path, "points");
     if (!points->is_array() || points->empty())
       in.fail(p, "expected a non-empty array of [x,y,z] points, got " + describeType(*points));
-    for (std::size_t i = 0; i < points->size(); ++i) stroke.points.push_back(in.vec3((*points)[i], indexPath(p, i)));
+    for (std::size_t i = 0; i < points->size(); ++i)
+      stroke.points.push_back(in.vec3OfNumbers((*points)[i], indexPath(p, i)));
     if (in.optional(node, "depth")) in.fail(childPath(path, "depth"), "only used with \"rays\"");
   } else {
     const std::string p = childPath(path, "rays");
@@ -330,8 +157,8 @@ Stroke parseStroke(const Reader& in, const json& node, const std::string& path) 
       in.requireObject(ray, rp);
       in.allowOnly(ray, rp, {"origin", "direction"});
       SurfaceRay r;
-      r.origin = in.vec3(in.required(ray, rp, "origin"), childPath(rp, "origin"));
-      r.direction = in.vec3(in.required(ray, rp, "direction"), childPath(rp, "direction"));
+      r.origin = in.vec3OfNumbers(in.required(ray, rp, "origin"), childPath(rp, "origin"));
+      r.direction = in.vec3OfNumbers(in.required(ray, rp, "direction"), childPath(rp, "direction"));
       if (!(r.direction.x != 0.0 || r.direction.y != 0.0 || r.direction.z != 0.0))
         in.fail(childPath(rp, "direction"), "must be a non-zero vector");
       stroke.rays.push_back(r);
@@ -352,7 +179,7 @@ nlohmann::ordered_json rgbJson(const glm::dvec3& v) { return nlohmann::ordered_j
 
 std::vector<Stroke> parseStrokes(const std::string& jsonText, const fs::path& file) {
   if (jsonText.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(file.string() + ": empty file");
-  PathTracker tracker(file);
+  JsonPathTracker tracker(file);
   json root;
   try {
     root = json::parse(jsonText, tracker);
@@ -378,21 +205,7 @@ std::vector<Stroke> parseStrokes(const std::string& jsonText, const fs::path& fi
 }
 
 std::vector<Stroke> loadStrokes(const fs::path& file) {
-  auto cannotRead = [&](int error) {
-    return InputError(file.string() + ": cannot read stroke file (" + std::strerror(error) + ")");
-  };
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) throw cannotRead(EISDIR);
-  std::FILE* stream = std::fopen(file.c_str(), "rb");
-  if (!stream) throw cannotRead(errno);
-  std::string text;
-  char buffer[65536];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, stream)) > 0) text.append(buffer, got);
-  const int readError = std::ferror(stream) ? errno : 0;
-  std::fclose(stream);
-  if (readError != 0) throw cannotRead(readError);
-  return parseStrokes(text, file);
+  return parseStrokes(readInputFile(file, "stroke file"), file);
 }
 
 std::string formatStrokes(const std::vector<Stroke>& strokes) {

@@ -1,78 +1,19 @@
 #include "volume/scene.h"
 
-#include <cerrno>
+#include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
-#include <initializer_list>
 #include <nlohmann/json.hpp>
-#include <set>
-#include <string_view>
 
 #include "volume/error.h"
+#include "volume/strict_json.h"
 
 namespace sslpv {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-// Key names and string values are echoed into one-line messages: a control character
-// (a JSON "\n" in a key, say) must not break the line.
-std::string printable(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-std::string childPath(const std::string& path, std::string_view key) {
-  return path.empty() ? printable(key) : path + "." + printable(key);
-}
-
-std::string indexPath(const std::string& path, std::size_t index) {
-  return path + "[" + std::to_string(index) + "]";
-}
-
-std::string formatNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", value);
-  return text;
-}
-
-std::string quotedList(std::initializer_list<const char*> names) {
-  std::string out;
-  for (const char* name : names) {
-    if (!out.empty()) out += ", ";
-    out += '"';
-    out += name;
-    out += '"';
-  }
-  return out;
-}
-
-/// "an object", "a string", ... for "expected X, got Y" messages.
-std::string describeType(const json& value) {
-  switch (value.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::object: return "an object";
-    case json::value_t::array: return "an array";
-    case json::value_t::string: return "a string";
-    case json::value_t::boolean: return "a boolean";
-    case json::value_t::binary: return "binary data";
-    case json::value_t::discarded: return "nothing";
-    default: return "a number";
-  }
-}
 
 /// Turns nlohmann's byte offset into the line and column an editor shows (both from 1).
 std::string lineAndColumn(const std::string& text, std::size_t byte) {
@@ -100,131 +41,10 @@ std::string jsonReason(const std::string& what) {
   return printable(reason);
 }
 
-/// Tracks where the parser is so a duplicated key can be named by its path. nlohmann keeps
-/// the last of two equal keys silently, which would hide a typo like a second "steps".
-class DuplicateKeyGuard {
- public:
-  explicit DuplicateKeyGuard(const fs::path& file) : file_(file) {}
-
-  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start: frames_.push_back({false, 0, {}, {}}); break;
-      case json::parse_event_t::array_start: frames_.push_back({true, 0, {}, {}}); break;
-      case json::parse_event_t::key: {
-        Frame& top = frames_.back();
-        top.key = parsed.get<std::string>();
-        if (!top.keys.insert(top.key).second)
-          throw InputError(file_.string() + ": " + childPath(enclosingPath(), top.key) +
-                           ": duplicate key");
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames_.pop_back();
-        completeValue();
-        break;
-      case json::parse_event_t::value: completeValue(); break;
-    }
-    return true;
-  }
-
- private:
-  struct Frame {
-    bool isArray;
-    std::size_t index;  // arrays: elements completed so far
-    std::string key;    // objects: the key being parsed
-    std::set<std::string> keys;
-  };
-
-  void completeValue() {
-    if (!frames_.empty() && frames_.back().isArray) ++frames_.back().index;
-  }
-
-  // Path of the innermost open object (the one receiving the key).
-  std::string enclosingPath() const {
-    std::string path;
-    for (std::size_t i = 0; i + 1 < frames_.size(); ++i)
-      path = frames_[i].isArray ? indexPath(path, frames_[i].index)
-                                : childPath(path, frames_[i].key);
-    return path;
-  }
-
-  const fs::path& file_;
-  std::vector<Frame> frames_;
-};
-
 /// Reads values out of the parsed document; every failure names the file and key path.
-class SceneReader {
+class SceneReader : public StrictJsonReader {
  public:
-  explicit SceneReader(const fs::path& file) : file_(file) {}
-
-  [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
-    throw InputError(file_.string() + ": " + (path.empty() ? "" : path + ": ") + reason);
-  }
-
-  void requireObject(const json& value, const std::string& path) const {
-    if (!value.is_object()) fail(path, "expected an object, got " + describeType(value));
-  }
-
-  /// Strictness: a misspelt key must not be ignored silently.
-  void allowOnly(const json& object, const std::string& path,
-                 std::initializer_list<const char*> accepted) const {
-    for (const auto& item : object.items()) {
-      bool known = false;
-      for (const char* name : accepted) known = known || item.key() == name;
-      if (!known)
-        fail(childPath(path, item.key()), "unknown key (accepted keys: " + quotedList(accepted) + ")");
-    }
-  }
-
-  const json* optional(const json& object, const char* key) const {
-    auto it = object.find(key);
-    return it == object.end() ? nullptr : &*it;
-  }
-
-  const json& required(const json& object, const std::string& path, const char* key) const {
-    auto it = object.find(key);
-    if (it == object.end()) fail(path, std::string("missing required key \"") + key + "\"");
-    return *it;
-  }
-
-  double number(const json& value, const std::string& path) const {
-    if (!value.is_number()) fail(path, "expected a number, got " + describeType(value));
-    double result = value.get<double>();
-    if (!std::isfinite(result)) fail(path, "expected a finite number");
-    return result;
-  }
-
-  int integer(const json& value, const std::string& path, int lo, int hi) const {
-    std::string expected = "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-    if (!value.is_number()) fail(path, expected + ", got " + describeType(value));
-    double result = value.get<double>();
-    if (result != std::floor(result)) fail(path, expected + ", got " + formatNumber(result));
-    if (!(result >= lo && result <= hi)) fail(path, expected + ", got " + formatNumber(result));
-    return static_cast<int>(result);
-  }
-
-  std::string string(const json& value, const std::string& path) const {
-    if (!value.is_string()) fail(path, "expected a string, got " + describeType(value));
-    return value.get<std::string>();
-  }
-
-  glm::dvec3 vec3(const json& value, const std::string& path, const char* what = "numbers") const {
-    std::string expected = std::string("expected an array of 3 ") + what;
-    if (!value.is_array() || value.size() != 3) {
-      fail(path, expected + ", got " +
-                     (value.is_array() ? "an array of " + std::to_string(value.size())
-                                       : describeType(value)));
-    }
-    glm::dvec3 result;
-    for (int i = 0; i < 3; ++i) {
-      const json& element = value[std::size_t(i)];
-      if (!element.is_number() || !std::isfinite(element.get<double>()))
-        fail(indexPath(path, i), expected + ", got " + describeType(element));
-      result[i] = element.get<double>();
-    }
-    return result;
-  }
+  using StrictJsonReader::StrictJsonReader;
 
   /// RGB radiometric quantities and coefficients: finite and non-negative.
   glm::dvec3 nonNegativeRgb(const json& value, const std::string& path) const {
@@ -255,11 +75,8 @@ class SceneReader {
   fs::path filePath(const json& value, const std::string& path) const {
     std::string text = string(value, path);
     if (text.empty()) fail(path, "expected a non-empty file path");
-    return (file_.parent_path() / fs::path(text)).lexically_normal();
+    return (file().parent_path() / fs::path(text)).lexically_normal();
   }
-
- private:
-  const fs::path& file_;
 };
 
 MeshSource parseMesh(const SceneReader& in, const json& node) {
@@ -472,7 +289,7 @@ Scene parseScene(const std::string& jsonText, const fs::path& file) {
     throw InputError(file.string() + ": empty file");
   json root;
   try {
-    root = json::parse(jsonText, DuplicateKeyGuard(file));
+    root = json::parse(jsonText, JsonPathTracker(file));
   } catch (const json::parse_error& e) {
     throw InputError(file.string() + ": " + lineAndColumn(jsonText, e.byte) +
                      ": malformed JSON: " + jsonReason(e.what()));
@@ -508,21 +325,7 @@ Scene parseScene(const std::string& jsonText, const fs::path& file) {
 }
 
 Scene loadScene(const fs::path& file) {
-  auto cannotRead = [&](int error) {
-    return InputError(file.string() + ": cannot read scene file (" + std::strerror(error) + ")");
-  };
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) throw cannotRead(EISDIR);
-  std::FILE* stream = std::fopen(file.c_str(), "rb");
-  if (!stream) throw cannotRead(errno);
-  std::string text;
-  char buffer[65536];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, stream)) > 0) text.append(buffer, got);
-  int readError = std::ferror(stream) ? errno : 0;
-  std::fclose(stream);
-  if (readError != 0) throw cannotRead(readError);
-  return parseScene(text, file);
+  return parseScene(readInputFile(file, "scene file"), file);
 }
 
 LpvSettings applyLpvFlags(LpvSettings settings, const LpvFlags& flags) {
