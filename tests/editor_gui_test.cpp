@@ -56,6 +56,10 @@ class EventScript {
     return *this;
   }
   EventScript& ctrl(char letter) { return key(std::string(1, letter), letter - 'a' + 1, 2); }
+  EventScript& wheelForward(int x, int y, int times) {
+    for (int i = 0; i < times; ++i) event("MouseWheelForwardEvent", x, y);
+    return *this;
+  }
   std::string str() const { return text_.str(); }
 
  private:
@@ -241,6 +245,42 @@ TEST(EditorGui, QuitAsksBeforeDroppingUnsavedWork) {
   ASSERT_EQ(r.exitCode, 0) << r.stderrText;
   EXPECT_FALSE(fs::exists(p.recovery)) << "quitting without saving should not leave a recovery file";
   EXPECT_FALSE(fs::exists(p.saved));
+}
+
+// Fraction of pixels in [x0, x1) x [y0, y1) (image rows from the top) whose largest
+// channel differs by more than 32 of 255.
+double changedFraction(const Image& a, const Image& b, int x0, int y0, int x1, int y1) {
+  Image ca(x1 - x0, y1 - y0), cb(x1 - x0, y1 - y0);
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      ca.at(x - x0, y - y0) = a.at(x, y);
+      cb.at(x - x0, y - y0) = b.at(x, y);
+    }
+  return compareImages(ca, cb).fractionOver;
+}
+
+TEST(EditorGui, HelpOverlayAndPreviewFollowingTheCamera) {
+  // h draws the key list over the window; zooming the 3D view (wheel) re-renders the
+  // preview through the new camera, so the preview half of the window changes while
+  // nothing was painted.
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  Project p;
+  const fs::path plain = p.dir / "plain.png", help = p.dir / "help.png", zoomed = p.dir / "zoomed.png";
+  auto run = [&](const std::string& events, const fs::path& shot) {
+    test::writeText(p.events, events);
+    const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--screenshot",
+                                   shot.string(), "--exit"});
+    ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  };
+  run(EventScript().str(), plain);
+  run(EventScript().key("h", 'h').str(), help);
+  run(EventScript().wheelForward(240, 402, 5).str(), zoomed);
+  const Image a = readImage(plain), b = readImage(help), c = readImage(zoomed);
+  // The overlay's text block sits in the lower left of the window.
+  EXPECT_GT(changedFraction(a, b, 0, 100, 960, 560), 0.05) << "the help overlay did not appear";
+  // Preview: x 480..960, rows 20..396 (below its label line).
+  EXPECT_GT(changedFraction(a, c, 480, 20, 960, 396), 0.02) << "the preview did not follow the camera";
+  EXPECT_FALSE(fs::exists(p.recovery)) << "nothing was painted, so there is nothing to recover";
 }
 
 }  // namespace

@@ -41,12 +41,14 @@ class EditorStyle : public vtkInteractorStyleTrackballCamera {
     Superclass::OnLeftButtonUp();
   }
   void OnMouseMove() override {
+    const int* p = Interactor->GetEventPosition();
     if (window->painting()) {
-      const int* p = Interactor->GetEventPosition();
       window->continuePaint(p[0], p[1]);
       return;
     }
     Superclass::OnMouseMove();
+    // Not while the camera moves: the picking would slow the rotation down.
+    if (State == VTKIS_NONE) window->hover(p[0], p[1]);
   }
   void OnMouseWheelForward() override { wheel(+1); }
   void OnMouseWheelBackward() override { wheel(-1); }

@@ -3,6 +3,7 @@
 #include <vtkActor.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
+#include <vtkCellPicker.h>
 #include <vtkCellArray.h>
 #include <vtkImageActor.h>
 #include <vtkImageData.h>
@@ -15,6 +16,7 @@
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkRendererCollection.h>
+#include <vtkSphereSource.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
@@ -163,6 +165,30 @@ void EditWindow::buildScene() {
   view3d_->AddActor(meshActor_);
   slices_ = std::make_unique<SliceViews>(session_.worldMesh().bounds(), mesh, view3d_, slices, kSliceSamples);
 
+  // The brush cursor: a unit wire sphere scaled to the brush radius.
+  auto sphere = vtkSmartPointer<vtkSphereSource>::New();
+  sphere->SetThetaResolution(24);
+  sphere->SetPhiResolution(12);
+  auto sphereMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  sphereMapper->SetInputConnection(sphere->GetOutputPort());
+  auto makeCursor = [&](vtkRenderer* renderer) {
+    auto actor = vtkSmartPointer<vtkActor>::New();
+    actor->SetMapper(sphereMapper);
+    actor->GetProperty()->SetRepresentationToWireframe();
+    actor->GetProperty()->SetColor(1.0, 0.85, 0.2);
+    actor->GetProperty()->SetOpacity(0.7);
+    actor->PickableOff();
+    actor->SetVisibility(false);
+    renderer->AddActor(actor);
+    return actor;
+  };
+  cursor3d_ = makeCursor(view3d_);
+  for (int a = 0; a < 3; ++a) cursorSlice_[a] = makeCursor(sliceViews_[a]);
+  picker_ = vtkSmartPointer<vtkCellPicker>::New();
+  picker_->PickFromListOn();
+  picker_->AddPickList(meshActor_);
+  picker_->SetTolerance(1e-4);
+
   // The 3D view starts at the scene's camera, which is also the preview's.
   const Camera& c = session_.scene().camera;
   vtkCamera* camera = view3d_->GetActiveCamera();
@@ -299,8 +325,41 @@ bool EditWindow::beginPaint(int x, int y) {
   return true;
 }
 
+void EditWindow::placeCursor(int x, int y) {
+  const double radius = controls_.brush().radius;
+  std::optional<glm::dvec3> at;
+  std::optional<int> sliceAxis;
+  if (controls_.paintMode() && !prompt_) {
+    vtkRenderer* target = rendererAt(x, y);
+    if (target == view3d_.Get()) {
+      if (picker_->Pick(x, y, 0.0, view3d_)) {
+        double p[3];
+        picker_->GetPickPosition(p);
+        at = glm::dvec3(p[0], p[1], p[2]);
+      }
+    } else if ((sliceAxis = slices_->axisOf(target))) {
+      at = slices_->worldPointAt(*sliceAxis, x, y);
+    }
+  }
+  std::array<vtkActor*, 4> cursors{cursor3d_, cursorSlice_[0], cursorSlice_[1], cursorSlice_[2]};
+  for (vtkActor* cursor : cursors) {
+    cursor->SetVisibility(at.has_value());
+    if (!at) continue;
+    cursor->SetPosition(at->x, at->y, at->z);
+    cursor->SetScale(radius);
+  }
+  if (at) view3d_->ResetCameraClippingRange();
+}
+
+void EditWindow::hover(int x, int y) {
+  const bool wasVisible = cursor3d_->GetVisibility() != 0;
+  placeCursor(x, y);
+  if (wasVisible || cursor3d_->GetVisibility()) window_->Render();
+}
+
 void EditWindow::continuePaint(int x, int y) {
   if (paintView_ == PaintView::None) return;
+  placeCursor(x, y);
   try {
     if (paintView_ == PaintView::Surface)
       session_.addRays({rayAt(x, y)});
@@ -487,6 +546,12 @@ bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char k
     handled = false;
   }
   if (handled) {
+    const double radius = controls_.brush().radius;
+    for (vtkActor* cursor : {cursor3d_.Get(), cursorSlice_[0].Get(), cursorSlice_[1].Get(), cursorSlice_[2].Get()})
+      cursor->SetScale(radius);
+    if (!controls_.paintMode())
+      for (vtkActor* cursor : {cursor3d_.Get(), cursorSlice_[0].Get(), cursorSlice_[1].Get(), cursorSlice_[2].Get()})
+        cursor->SetVisibility(false);
     updateStatus();
     window_->Render();
   }

@@ -16,6 +16,7 @@
 #include "editor/edit_session.h"
 
 class vtkActor;
+class vtkCellPicker;
 class vtkImageActor;
 class vtkImageData;
 class vtkRenderWindow;
@@ -57,6 +58,8 @@ class EditWindow {
   void endPaint();
   bool painting() const { return paintView_ != PaintView::None; }
   bool is3dView(const vtkRenderer* renderer) const { return renderer != nullptr && renderer == view3d_.Get(); }
+  /// The mouse moved without painting: the brush cursor follows it (paint mode only).
+  void hover(int x, int y);
   /// The 3D view's camera moved: the preview follows it.
   void cameraMoved();
   void onTimer();
@@ -75,6 +78,9 @@ class EditWindow {
   bool handlePromptKey(const std::string& keySym, char keyCode);
   void maybeAutosave(bool strokeJustEnded);
   SurfaceRay rayAt(int x, int y) const;
+  /// Shows the brush (a wire sphere of its radius) at the surface or slice point under
+  /// (x, y); hides it where there is none.
+  void placeCursor(int x, int y);
   vtkRenderer* rendererAt(int x, int y) const;
 
   EditSession& session_;
@@ -87,6 +93,9 @@ class EditWindow {
   vtkSmartPointer<vtkRenderer> view3d_, preview_, overlay_;
   std::array<vtkSmartPointer<vtkRenderer>, 3> sliceViews_;
   vtkSmartPointer<vtkActor> meshActor_;
+  vtkSmartPointer<vtkActor> cursor3d_;
+  std::array<vtkSmartPointer<vtkActor>, 3> cursorSlice_;
+  vtkSmartPointer<vtkCellPicker> picker_;
   vtkSmartPointer<vtkImageData> previewImage_;
   vtkSmartPointer<vtkImageActor> previewActor_;
   vtkSmartPointer<vtkTextActor> status_, message_, help_, unsavedMarker_, previewLabel_;
