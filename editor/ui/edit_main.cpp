@@ -182,7 +182,7 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   Options options;
-  CLI::App app{"sslpv edit: paint sigma_t, sigma_s and g into a scene's material set with a live SSLPV preview"};
+  CLI::App app{"sslpv edit: paint sigma_t, sigma_s and g into a scene's material set with a live SSLPV preview", "sslpv edit"};
   app.add_option("scene", options.scene, "Scene JSON file")->required();
   CLI::Option* backend = app.add_option("--backend", options.backend,
                                         "Preview backend: vulkan (default; the CPU when there is no device) or cpu")

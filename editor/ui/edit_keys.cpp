@@ -1,0 +1,138 @@
+// The editor window's keyboard: brush controls, undo/redo, files, help, quitting, and the
+// typed path of "export material set". Kept apart from the window's layout and painting.
+#include <vtkActor.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkTextActor.h>
+
+#include <cctype>
+#include <string>
+
+#include "editor/ui/edit_window.h"
+
+namespace sslpv {
+
+void EditWindow::startExportPrompt() {
+  const std::filesystem::path& scene = session_.paths().scene;
+  prompt_ = (scene.parent_path() / (scene.stem().string() + "_export.vdb")).string();
+  showMessage("export to: " + *prompt_ + "_   (Enter writes, Esc cancels)", false);
+}
+
+bool EditWindow::handlePromptKey(const std::string& keySym, char keyCode) {
+  if (keySym == "Escape") {
+    prompt_.reset();
+    showMessage("export cancelled", false);
+  } else if (keySym == "Return" || keySym == "KP_Enter") {
+    const std::string path = *prompt_;
+    prompt_.reset();
+    try {
+      session_.exportMaterialSet(path);
+      showMessage("exported material set to " + path, false);
+    } catch (const std::exception& e) {
+      showMessage(std::string("export failed: ") + e.what(), true);
+    }
+  } else {
+    if (keySym == "BackSpace") {
+      if (!prompt_->empty()) prompt_->pop_back();
+    } else if (keyCode >= 32 && keyCode < 127) {
+      prompt_->push_back(keyCode);
+    }
+    showMessage("export to: " + *prompt_ + "_   (Enter writes, Esc cancels)", false);
+  }
+  return true;
+}
+
+bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char keyCode) {
+  if (prompt_) {
+    handlePromptKey(key, keyCode);
+    window_->Render();
+    return true;
+  }
+  if (key != "q" && key != "e") quitArmed_ = false;
+  const std::string lower = key.size() == 1 ? std::string(1, char(std::tolower(key[0]))) : key;
+  bool handled = true;
+  if (ctrl) {
+    if (lower == "z" && !shift) {
+      afterChange(session_.undo(), "undo");
+    } else if ((lower == "z" && shift) || lower == "y") {
+      afterChange(session_.redo(), "redo");
+    } else if (lower == "s") {
+      save();
+    } else if (lower == "e") {
+      startExportPrompt();
+    } else {
+      handled = false;
+    }
+  } else if (recoveryPending_ && key == "R") {
+    try {
+      session_.recover();
+      recoveryPending_ = false;
+      showMessage("recovered the earlier session's work (not saved yet: Ctrl+S saves it)", false);
+      afterChange(std::nullopt, "recover");
+    } catch (const std::exception& e) {
+      showMessage(std::string("recovery failed: ") + e.what(), true);
+    }
+  } else if (recoveryPending_ && key == "D") {
+    try {
+      session_.discardRecovery();
+      recoveryPending_ = false;
+      showMessage("discarded the earlier session's unsaved work", false);
+    } catch (const std::exception& e) {
+      showMessage(std::string("could not delete the recovery file: ") + e.what(), true);
+    }
+  } else if (key == "space") {
+    controls_.setPaintMode(!controls_.paintMode());
+  } else if (lower == "c") {
+    controls_.cycleChannel(shift ? -1 : 1);
+    updateSlices();
+  } else if (lower == "m") {
+    controls_.cycleMode(shift ? -1 : 1);
+  } else if (key == "o") {
+    controls_.cycleFalloff();
+  } else if (key == "comma" || key == "period") {
+    controls_.adjustValue(key == "period" ? 1 : -1);
+  } else if (key == "semicolon" || key == "apostrophe") {
+    controls_.adjustAlbedo(key == "apostrophe" ? 1 : -1);
+  } else if (key == "v") {
+    controls_.cycleComponent();
+  } else if (key == "n") {
+    controls_.negateValue();
+  } else if (key == "bracketleft" || key == "bracketright") {
+    controls_.scaleRadius(key == "bracketright" ? 1.2 : 1.0 / 1.2);
+  } else if (key == "minus" || key == "equal" || key == "plus") {
+    controls_.adjustStrength(key == "minus" ? -0.05 : 0.05);
+  } else if (key == "x") {
+    controls_.cycleMirror();
+  } else if (lower == "i") {
+    controls_.adjustDepth(shift ? -1 : 1);
+  } else if (key == "h" || key == "question" || key == "F1") {
+    helpVisible_ = !helpVisible_;
+    help_->SetVisibility(helpVisible_);
+  } else if (key == "Escape") {
+    helpVisible_ = false;
+    help_->SetVisibility(false);
+    showMessage("", false);
+  } else if (key == "q" || key == "e") {
+    if (session_.unsaved() && !quitArmed_) {
+      quitArmed_ = true;
+      showMessage("Unsaved changes: Ctrl+S saves them; press " + key + " again to quit without saving", true);
+    } else {
+      quit_ = true;
+    }
+  } else {
+    handled = false;
+  }
+  if (handled) {
+    const double radius = controls_.brush().radius;
+    for (vtkActor* cursor : {cursor3d_.Get(), cursorSlice_[0].Get(), cursorSlice_[1].Get(), cursorSlice_[2].Get()})
+      cursor->SetScale(radius);
+    if (!controls_.paintMode())
+      for (vtkActor* cursor : {cursor3d_.Get(), cursorSlice_[0].Get(), cursorSlice_[1].Get(), cursorSlice_[2].Get()})
+        cursor->SetVisibility(false);
+    updateStatus();
+    window_->Render();
+  }
+  return handled;
+}
+
+}  // namespace sslpv
