@@ -14,7 +14,9 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 8;  // see the bindings of shaders/shade.{vert,comp}
+constexpr std::uint32_t kBindings = 9;  // see the bindings of shaders/shade.{vert,comp}
+constexpr std::size_t kExitLawValues =
+    std::size_t(SSLPV_EXIT_LAW_ALBEDO_INTERVALS + 1) * std::size_t(SSLPV_EXIT_LAW_MU_INTERVALS + 1);
 constexpr VkFormat kTriangleFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
@@ -66,16 +68,33 @@ Buffer uploadLightField(const VulkanDevice& device, const ShGrid& grid) {
   return buffer;
 }
 
-Buffer uploadExitGain(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame) {
+Buffer uploadExitFactors(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame) {
   const std::size_t cells = frame.cellCount();
   for (const std::vector<float>& gain : factors.exitGain)
-    if (gain.size() != cells) throw GpuError("uploadExitGain: the step factors do not match the grid frame");
-  std::vector<float> packed(std::max<std::size_t>(cells, 1) * 4, 0.0f);
-  for (std::size_t i = 0; i < cells; ++i)
-    for (int ch = 0; ch < 3; ++ch) packed[i * 4 + ch] = factors.exitGain[ch][i];
+    if (gain.size() != cells) throw GpuError("uploadExitFactors: the step factors do not match the grid frame");
+  const bool exitLaw = !factors.reducedAlbedo[0].empty();
+  if (exitLaw)
+    for (const std::vector<float>& albedo : factors.reducedAlbedo)
+      if (albedo.size() != cells) throw GpuError("uploadExitFactors: the reduced albedos do not match the grid frame");
+  std::vector<float> packed(std::max<std::size_t>(cells, 1) * 8, 0.0f);
+  for (std::size_t i = 0; i < cells; ++i) {
+    for (int ch = 0; ch < 3; ++ch) {
+      packed[i * 8 + ch] = factors.exitGain[ch][i];
+      if (exitLaw) packed[i * 8 + 4 + ch] = factors.reducedAlbedo[ch][i];
+    }
+    packed[i * 8 + 7] = exitLaw ? 1.0f : 0.0f;
+  }
   Buffer buffer(device, packed.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                 MemoryUse::Device);
   uploadToBuffer(device, buffer, packed.data(), packed.size() * sizeof(float));
+  return buffer;
+}
+
+Buffer uploadExitLaw(const VulkanDevice& device, const ExitLawTable& table) {
+  if (table.shape.size() != kExitLawValues) throw GpuError("uploadExitLaw: the table has the wrong size");
+  Buffer buffer(device, table.shape.size() * sizeof(float),
+                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Device);
+  uploadToBuffer(device, buffer, table.shape.data(), table.shape.size() * sizeof(float));
   return buffer;
 }
 
@@ -115,7 +134,8 @@ GpuShader::GpuShader(const VulkanDevice& device, const GpuMesh& mesh, int width,
 }
 
 void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
-                       const Buffer& exitGain, const GridFrame& frame, double ior, TimestampQueries* timestamps, std::uint32_t firstQuery) {
+                       const Buffer& exitFactors, const Buffer& exitLaw, const GridFrame& frame, double ior,
+                       TimestampQueries* timestamps, std::uint32_t firstQuery) {
   if (camera.width != width_ || camera.height != height_)
     throw GpuError("GpuShader: the camera is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
                    ", the shader renders " + std::to_string(width_) + "x" + std::to_string(height_));
@@ -123,14 +143,16 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
   if (frame.cellCount() > std::size_t(0xffffffffu) / 3) throw GpuError("GpuShader: the grid has too many cells");
   requireBytes(accumulated, lightFieldBytes(frame), "accumulated light field");
   requireBytes(cellCoverage, VkDeviceSize(frame.cellCount()) * sizeof(float), "cell coverage");
-  requireBytes(exitGain, VkDeviceSize(frame.cellCount()) * 4 * sizeof(float), "exit gain");
+  requireBytes(exitFactors, VkDeviceSize(frame.cellCount()) * 8 * sizeof(float), "exit factors");
+  requireBytes(exitLaw, VkDeviceSize(kExitLawValues * sizeof(float)), "exit law");
   // Rewritten every recording, hence one recording in flight per shader (see the class).
   sets_.write(0, 0, mesh_.positions());
   sets_.write(0, 1, mesh_.indices());
   sets_.write(0, 2, accumulated);
   sets_.write(0, 3, cellCoverage);
   sets_.write(0, 6, mesh_.vertexFans());
-  sets_.write(0, 7, exitGain);
+  sets_.write(0, 7, exitFactors);
+  sets_.write(0, 8, exitLaw);
   const GpuShadePush push = shadePush(camera, mesh_.bounds(), frame, ior);
 
   if (timestamps) timestamps->write(cmd, firstQuery);
@@ -173,10 +195,10 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
 }
 
 Image GpuShader::shade(const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
-                       const Buffer& exitGain, const GridFrame& frame, double ior) {
+                       const Buffer& exitFactors, const Buffer& exitLaw, const GridFrame& frame, double ior) {
   VkCommandBuffer cmd = commands_.begin();
   timestamps_.reset(cmd);
-  record(cmd, camera, accumulated, cellCoverage, exitGain, frame, ior, &timestamps_, 0);
+  record(cmd, camera, accumulated, cellCoverage, exitFactors, exitLaw, frame, ior, &timestamps_, 0);
   commands_.submitAndWait();
   lastShadeMs_ = timestamps_.readMilliseconds(2)[1];
 

@@ -18,6 +18,7 @@
 #include "gpu/compute.h"
 #include "gpu/graphics.h"
 #include "shaders/shade_shared.h"
+#include "volume/exit_law.h"
 #include "volume/image_io.h"
 #include "volume/lpv_grid.h"
 #include "volume/scene.h"
@@ -31,9 +32,15 @@ namespace sslpv::gpu {
 /// shading, and for tests.
 Buffer uploadLightField(const VulkanDevice& device, const ShGrid& grid);
 
-/// A new device storage buffer with StepFactors::exitGain as one vec4 (r, g, b, 0) per
-/// cell, the shading pass's per-cell radiance gain (binding 7 of shaders/shade.comp).
-Buffer uploadExitGain(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame);
+/// A new device storage buffer with two vec4 per cell (binding 7 of shaders/shade.comp):
+/// (StepFactors::exitGain rgb, 0), the per-cell radiance gain, and
+/// (StepFactors::reducedAlbedo rgb, 1) selecting the cell's exit angular shape, or
+/// (0, 0, 0, 0) when the factors have no reduced albedo (seed scheme: no exit law).
+Buffer uploadExitFactors(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame);
+
+/// A new device storage buffer holding `table.shape` (binding 8 of shaders/shade.comp):
+/// upload once per η; shadeImage's exitLawTable(ior) on the CPU side.
+Buffer uploadExitLaw(const VulkanDevice& device, const ExitLawTable& table);
 
 /// Shades one camera view of one mesh. Constructed once per object and image size;
 /// record()/shade() per frame. One recording in flight at a time (record() rewrites the
@@ -46,18 +53,20 @@ class GpuShader {
 
   /// Records the shading pass into radiance(). `accumulated`: the accumulated light field
   /// of `frame` in GpuPropagator's layout; `cellCoverage`: uploadCellCoverage()
-  /// (gpu/gpu_inject.h) of the material on `frame`; `exitGain`: uploadExitGain(). Starts with a barrier making earlier compute and
+  /// (gpu/gpu_inject.h) of the material on `frame`; `exitFactors`: uploadExitFactors();
+  /// `exitLaw`: uploadExitLaw(exitLawTable(ior)). Starts with a barrier making earlier compute and
   /// transfer writes (propagation) visible to the pass, and ends with one making
   /// radiance() visible to transfers, compute shaders and the host. The camera must have
   /// the shader's width and height. With `timestamps`, writes `firstQuery` (start) and
   /// `firstQuery + 1` (end); the caller resets them.
   void record(VkCommandBuffer cmd, const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
-              const Buffer& exitGain, const GridFrame& frame, double ior, TimestampQueries* timestamps = nullptr, std::uint32_t firstQuery = 0);
+              const Buffer& exitFactors, const Buffer& exitLaw, const GridFrame& frame, double ior,
+              TimestampQueries* timestamps = nullptr, std::uint32_t firstQuery = 0);
 
   /// record() plus a copy into host memory, submitted and waited for; the image as
   /// shadeImage returns it (row 0 at the top, background 0).
-  Image shade(const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage, const Buffer& exitGain,
-              const GridFrame& frame, double ior);
+  Image shade(const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage, const Buffer& exitFactors,
+              const Buffer& exitLaw, const GridFrame& frame, double ior);
 
   /// GPU milliseconds of the shading pass in the last shade() (0 without timestamps).
   double lastShadeMs() const { return lastShadeMs_; }

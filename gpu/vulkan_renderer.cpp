@@ -72,7 +72,7 @@ void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report)
     report.resampledCells = material_.frame.cellCount();
   }
   factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
-  exitGain_ = std::make_unique<Buffer>(uploadExitGain(device_, factors_, material_.frame));
+  exitFactors_ = std::make_unique<Buffer>(uploadExitFactors(device_, factors_, material_.frame));
   report.activeCells = 0;
   for (unsigned char a : factors_.active) report.activeCells += a;
   if (propagator_) {
@@ -159,8 +159,10 @@ Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOu
   if (dirty_.dirty(Stage::Shading)) {
     if (!shader_ || shader_->width() != scene_.camera.width || shader_->height() != scene_.camera.height)
       shader_ = std::make_unique<GpuShader>(device_, *mesh_, scene_.camera.width, scene_.camera.height);
-    image_ = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, *exitGain_, material_.frame,
-                            scene_.material.ior);
+    // The scene's η is fixed for the renderer: one table (built once per process and η).
+    if (!exitLaw_) exitLaw_ = std::make_unique<Buffer>(uploadExitLaw(device_, exitLawTable(scene_.material.ior)));
+    image_ = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, *exitFactors_, *exitLaw_,
+                            material_.frame, scene_.material.ior);
     report.times.shading = shader_->lastShadeMs();
   } else {
     report.times.markCached(Stage::Shading);

@@ -64,7 +64,8 @@ class VulkanRenderer {
   std::optional<LpvSettings> lastSettings_;
   MaterialGrid material_;
   StepFactors factors_;
-  std::unique_ptr<Buffer> exitGain_;  ///< factors_.exitGain on the device, for shading
+  std::unique_ptr<Buffer> exitFactors_;  ///< factors_' exit gain and reduced albedo on the device, for shading
+  std::unique_ptr<Buffer> exitLaw_;      ///< exitLawTable(scene_.material.ior), uploaded at the first shading
   std::unique_ptr<GpuVoxelizer> voxelizer_;
   std::unique_ptr<Buffer> cellCoverage_;
   std::unique_ptr<GpuShadowMapper> shadowMapper_;

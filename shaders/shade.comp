@@ -5,7 +5,8 @@
 // the pixel's camera ray meets the triangle's plane; the accumulated LPV is read half a
 // cell inside the surface (a full cell when no active cell is near) with the
 // coverage-weighted active trilinear weights of activeTrilinearWeights; radiance
-// L = T(θo)/η² · (1/(Aπ)) ∫_H G I(ω) dω per channel, G the cell's exit gain.
+// L = T(θo)/η² · (1/(Aπ)) ∫_H G h I(ω) dω per channel, G the cell's exit gain and h its
+// exit angular shape (volume/exit_law.h; 1 in the seed scheme).
 // Output: one vec4 per pixel, row 0 at
 // the top, (radiance, 1) on the surface (black where the ray leaves from inside or no
 // active cell is near), (0, 0, 0, 0) for the background.
@@ -28,11 +29,28 @@ layout(std430, set = 0, binding = 2) readonly buffer Field { vec4 field[]; };
 layout(std430, set = 0, binding = 4) buffer Triangles { uint triangles[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Radiance { vec4 radiance[]; };
 layout(std430, set = 0, binding = 6) readonly buffer VertexFans { uint vertexFans[]; };
-// Per cell (r, g, b, 0): StepFactors::exitGain, the calibrated scheme's surface coupling.
-layout(std430, set = 0, binding = 7) readonly buffer ExitGain { vec4 exitGain[]; };
+// Per cell two vec4 (gpu::uploadExitFactors): (StepFactors::exitGain rgb, 0), the
+// calibrated scheme's surface coupling, and (StepFactors::reducedAlbedo rgb, 1), or
+// (0, 0, 0, 0) without an exit law (seed scheme).
+layout(std430, set = 0, binding = 7) readonly buffer ExitFactors { vec4 exitFactors[]; };
+// ExitLawTable::shape of the scene's η (gpu::uploadExitLaw).
+layout(std430, set = 0, binding = 8) readonly buffer ExitLaw { float exitLaw[]; };
 layout(push_constant) uniform Push { GpuShadePush push; };
 
 #include "shaders/ray_triangle_pick.glsl"
+
+// Twin of sslpv::exitLawShape (volume/exit_law.cpp), line for line: bilinear in
+// t = sqrt(1 - α') and μo; `j`/`fm` are the μo part, shared by a pixel's cells.
+float exitLawShape(float albedo, int j, float fm) {
+  const float t = sqrt(clamp(1.0 - albedo, 0.0, 1.0)) * float(SSLPV_EXIT_LAW_ALBEDO_INTERVALS);
+  const int k = min(int(t), SSLPV_EXIT_LAW_ALBEDO_INTERVALS - 1);
+  const float ft = t - float(k);
+  const int low = k * (SSLPV_EXIT_LAW_MU_INTERVALS + 1) + j;
+  const int high = low + (SSLPV_EXIT_LAW_MU_INTERVALS + 1);
+  const float a = exitLaw[low] + fm * (exitLaw[low + 1] - exitLaw[low]);
+  const float b = exitLaw[high] + fm * (exitLaw[high + 1] - exitLaw[high]);
+  return a + ft * (b - a);
+}
 
 void main() {
   const uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -74,9 +92,17 @@ void main() {
     if (used == 0) used = activeTrilinearWeights(grid, p - cellSize * n, cells, weights);
     if (used > 0) {
       const float scale = push.viewport.z * (1.0 - fresnelReflectance(cosOut, push.up.w));
+      const float m = clamp(cosOut, 0.0, 1.0) * float(SSLPV_EXIT_LAW_MU_INTERVALS);
+      const int j = min(int(m), SSLPV_EXIT_LAW_MU_INTERVALS - 1);
+      const float fm = m - float(j);
       for (int ch = 0; ch < 3; ++ch) {
         vec4 c = vec4(0.0);
-        for (int i = 0; i < used; ++i) c += weights[i] * exitGain[cells[i]][ch] * field[3u * cells[i] + uint(ch)];
+        for (int i = 0; i < used; ++i) {
+          const vec4 gain = exitFactors[2u * cells[i]], albedo = exitFactors[2u * cells[i] + 1u];
+          float s = weights[i] * gain[ch];
+          if (albedo.w != 0.0) s *= exitLawShape(albedo[ch], j, fm);
+          c += s * field[3u * cells[i] + uint(ch)];
+        }
         result[ch] = max(0.0, float(SSLPV_HEMI_Y00) * c.x + float(SSLPV_HEMI_Y1) * dot(c.yzw, n)) * scale;
       }
     }

@@ -28,6 +28,9 @@
 //   1e-5);
 // - mean relative difference over all object pixels (silhouettes and edges included)
 //   <= 1 %.
+// The exit gains and reduced albedos (exit law, volume/exit_law.h) vary per cell, so the
+// GPU's per-cell lookups of both are compared with the CPU's; one case without reduced
+// albedos checks that both then keep the Lambertian exit.
 #include "gpu/gpu_shade.h"
 
 #include <gtest/gtest.h>
@@ -41,6 +44,7 @@
 #include "gpu_test_fixture.h"
 #include "image_agreement.h"
 #include "test_meshes.h"
+#include "volume/exit_law.h"
 #include "volume/lpv_stages.h"
 #include "volume/ray_scene.h"
 #include "volume/shadow_view.h"
@@ -82,11 +86,15 @@ LitObject lightObject(TriangleMesh mesh, const std::vector<Light>& lights, doubl
   options.steps = 24;
   o.factors = computeStepFactors(o.material, LpvScheme::Calibrated, ior);
   propagate(o.material, o.factors, field, o.accumulated, options);
-  // A homogeneous medium has one gain per channel; vary it per cell so a wrong cell or
-  // channel index in the GPU's gain lookup shows.
+  // A homogeneous medium has one gain and one reduced albedo per channel; vary them per
+  // cell so a wrong cell or channel index in the GPU's gain or exit-law lookup shows. The
+  // albedos span [0, 1] (t = sqrt(1 - α') over the whole table, single-scattering-like
+  // cells included), so the shape varies per cell by up to ~30 %.
   for (int ch = 0; ch < 3; ++ch)
-    for (std::size_t i = 0; i < o.factors.exitGain[ch].size(); ++i)
+    for (std::size_t i = 0; i < o.factors.exitGain[ch].size(); ++i) {
       o.factors.exitGain[ch][i] *= float(1.0 + 0.5 * std::sin(0.37 * double(i) + 1.7 * ch));
+      o.factors.reducedAlbedo[ch][i] = float(0.5 + 0.5 * std::sin(0.91 * double(i) + 0.6 * ch));
+    }
   return o;
 }
 
@@ -118,13 +126,15 @@ class GpuShadeTest : public GpuTest {
   /// Shades `o` from `camera` with both backends and checks the expectations above.
   void compareWithCpu(const LitObject& o, const Camera& camera, double ior, const std::string& what) {
     RayScene rays(o.mesh);
-    const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, ior, &o.factors.exitGain);
+    const Image cpu =
+        shadeImage(camera, rays, o.material, o.accumulated, ior, &o.factors.exitGain, &o.factors.reducedAlbedo);
     gpu::GpuMesh mesh(device(), o.mesh);
     gpu::GpuShader shader(device(), mesh, camera.width, camera.height);
     const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
     const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
-  const gpu::Buffer gain = gpu::uploadExitGain(device(), o.factors, o.material.frame);
-    const Image gpuImage = shader.shade(camera, field, coverage, gain, o.material.frame, ior);
+    const gpu::Buffer exitFactors = gpu::uploadExitFactors(device(), o.factors, o.material.frame);
+    const gpu::Buffer exitLaw = gpu::uploadExitLaw(device(), exitLawTable(ior));
+    const Image gpuImage = shader.shade(camera, field, coverage, exitFactors, exitLaw, o.material.frame, ior);
     ASSERT_EQ(gpuImage.width, cpu.width);
     ASSERT_EQ(gpuImage.height, cpu.height);
     const std::vector<std::uint32_t> gpuTriangles = shader.readTriangles(), cpuTri = cpuTriangles(camera, rays);
@@ -190,13 +200,15 @@ TEST_F(GpuShadeTest, FromInsideTheObjectEverythingIsBlackOnBoth) {
       lightObject(makeIcosphere(glm::vec3(0.0f), 1.0f, 4), {pointLight({0, 2, 3}, glm::vec3(5.0f))}, 1.3, 24);
   const Camera camera = cameraAt({0.1, 0.2, 0.3}, {1.0, 0.0, 0.0}, 128, 96, 60.0);
   RayScene rays(o.mesh);
-  const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain);
+  const Image cpu =
+      shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain, &o.factors.reducedAlbedo);
   gpu::GpuMesh mesh(device(), o.mesh);
   gpu::GpuShader shader(device(), mesh, camera.width, camera.height);
   const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
   const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
-  const gpu::Buffer gain = gpu::uploadExitGain(device(), o.factors, o.material.frame);
-  const Image gpuImage = shader.shade(camera, field, coverage, gain, o.material.frame, 1.3);
+  const gpu::Buffer exitFactors = gpu::uploadExitFactors(device(), o.factors, o.material.frame);
+  const gpu::Buffer exitLaw = gpu::uploadExitLaw(device(), exitLawTable(1.3));
+  const Image gpuImage = shader.shade(camera, field, coverage, exitFactors, exitLaw, o.material.frame, 1.3);
   const std::vector<std::uint32_t> gpuTriangles = shader.readTriangles(), cpuTri = cpuTriangles(camera, rays);
   std::size_t black = 0, sameTriangle = 0;
   for (std::size_t i = 0; i < cpu.pixels.size(); ++i) {
@@ -215,6 +227,29 @@ TEST_F(GpuShadeTest, BoxMatchesCpuShadingIndexMatched) {
   compareWithCpu(o, cameraAt({2.2, 1.8, 3.4}, {0.1, 0.15, 0.0}, 384, 384), 1.0, "box 384x384");
 }
 
+TEST_F(GpuShadeTest, WithoutReducedAlbedosBothKeepTheLambertianExit) {
+  // The seed scheme has no reduced albedos: the GPU must then skip the exit law (flag 0 in
+  // the exit factors) as the CPU does, and the law must actually change the image.
+  const std::vector<Light> lights = {pointLight({0.5, 2.5, 2.0}, {6.0f, 6.0f, 6.0f})};
+  LitObject o = lightObject(makeBoxMesh(glm::vec3(-1.0f, -0.7f, -0.5f), glm::vec3(1.2f, 1.0f, 0.5f)), lights, 1.3, 24);
+  const Camera camera = cameraAt({2.2, 1.8, 3.4}, {0.1, 0.15, 0.0}, 256, 256);
+  RayScene rays(o.mesh);
+  const Image withLaw =
+      shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain, &o.factors.reducedAlbedo);
+  for (std::vector<float>& albedo : o.factors.reducedAlbedo) albedo.clear();
+  const Image withoutLaw =
+      shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain, &o.factors.reducedAlbedo);
+  double changed = 0.0, lit = 0.0;
+  for (std::size_t i = 0; i < withLaw.pixels.size(); ++i)
+    for (int ch = 0; ch < 3; ++ch)
+      if (withoutLaw.pixels[i][ch] > 0.0f) {
+        lit += 1.0;
+        changed += std::abs(withLaw.pixels[i][ch] / withoutLaw.pixels[i][ch] - 1.0) > 0.01 ? 1.0 : 0.0;
+      }
+  EXPECT_GT(changed, 0.5 * lit) << "the varied reduced albedos should change most pixels by more than 1 %";
+  compareWithCpu(o, camera, 1.3, "box 256x256, no exit law");
+}
+
 TEST_F(GpuShadeTest, ReportsGpuTimeOfA512ImageOfA20KTriangleSphere) {
   // Not a performance assertion: prints the GPU time (timestamps) of shading a 512²
   // image of a 20,480-triangle sphere filling about half of it, median of 5 runs after
@@ -226,11 +261,12 @@ TEST_F(GpuShadeTest, ReportsGpuTimeOfA512ImageOfA20KTriangleSphere) {
   gpu::GpuShader shader(device(), mesh, 512, 512);
   const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
   const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
-  const gpu::Buffer gain = gpu::uploadExitGain(device(), o.factors, o.material.frame);
-  shader.shade(camera, field, coverage, gain, o.material.frame, 1.3);
+  const gpu::Buffer exitFactors = gpu::uploadExitFactors(device(), o.factors, o.material.frame);
+  const gpu::Buffer exitLaw = gpu::uploadExitLaw(device(), exitLawTable(1.3));
+  shader.shade(camera, field, coverage, exitFactors, exitLaw, o.material.frame, 1.3);
   std::vector<double> ms;
   for (int i = 0; i < 5; ++i) {
-    shader.shade(camera, field, coverage, gain, o.material.frame, 1.3);
+    shader.shade(camera, field, coverage, exitFactors, exitLaw, o.material.frame, 1.3);
     ms.push_back(shader.lastShadeMs());
   }
   std::sort(ms.begin(), ms.end());

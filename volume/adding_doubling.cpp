@@ -296,6 +296,7 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
   const double entering = 1.0 - fresnelReflectance(1.0, eta);
   for (double& v : u) v *= entering;
   Lu(a).solve(u);
+  result.upward = u;
   result.exitFlux.resize(bins);
   for (int i = 0; i < n; ++i) {
     result.exitFlux[std::size_t(i)] = (1.0 - fresnel[std::size_t(i)]) * u[std::size_t(i)];

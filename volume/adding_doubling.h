@@ -49,6 +49,11 @@ struct HalfSpaceReflectance {
   /// (sums to rd). Exitant radiance outside along the refracted direction of node i:
   /// π L / E = exitFlux[i] / (2 weight[i] mu[i] η²).
   std::vector<double> exitFlux;
+  /// Power arriving at the boundary from inside in each node's bin, per unit incident
+  /// power, before the boundary splits it (exitFlux = (1 - F) upward). The radiance just
+  /// below the boundary along node i is proportional to upward[i] / (weight[i] mu[i]):
+  /// the medium's exit angular shape (volume/exit_law.h).
+  std::vector<double> upward;
 };
 
 /// Rd of a semi-infinite medium with single-scattering albedo `albedo` in [0, 1] and

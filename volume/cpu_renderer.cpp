@@ -125,7 +125,8 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
   }
 
   if (dirty_.dirty(Stage::Shading)) {
-    image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain);
+    image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
+                        &factors_.reducedAlbedo);
     report.times.shading = watch.lapMs();
   } else {
     report.times.markCached(Stage::Shading);

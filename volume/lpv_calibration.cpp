@@ -150,7 +150,7 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   const double target = boundaryReflectance(reducedAlbedo, ior) / (boundary.entering * boundary.leaving);
   double gain = latticeReflectance > 0.0 ? target / latticeReflectance : 0.0;
   if (!std::isfinite(gain) || reducedAlbedo <= 0.0) gain = 0.0;
-  return {float(survival), 0.0f, float(gain)};
+  return {float(survival), 0.0f, float(gain), float(reducedAlbedo)};
 }
 
 }  // namespace sslpv

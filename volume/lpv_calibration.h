@@ -31,8 +31,11 @@
 //     injection's entry transmittance 1 - F(0) and the shading's exit transmittance of an
 //     isotropic cell (diffuseBoundaryTransmittance) are divided out:
 //        G = Rd(α', η) / ((1 - F(0)) · T_exit(η) · R_lpv).
-//     So the reflected power is exact for a thick slab; its angular distribution is the
-//     lattice's (Lambertian inside, Fresnel-weighted outside), not the medium's.
+//     So the reflected power is exact for a thick slab.
+//  4. Gives that power the medium's angular distribution instead of the lattice's
+//     (Lambertian inside, Fresnel-weighted outside): the shading weights each cell's
+//     exitant radiance by the half-space's exit shape for its α' and η, normalised to
+//     the same total power (volume/exit_law.h).
 //     (The η-dependence used to come from the dipole's ratio Rd(α', η) / Rd(α', 1): at
 //     η = 1.3 it put the reflected power per entering power 1 % low at α' ≈ 1 and up to
 //     85 % high at α' = 0.02, Jensen's ketchup blue.)
@@ -55,6 +58,9 @@ struct CellTransport {
   float dc = 1.0f;        ///< DC band factor per step
   float linear = 1.0f;    ///< linear band factor per step
   float exitGain = 1.0f;  ///< multiplies the exitant radiance read from this cell
+  /// α' = σs(1-g) / (σa + σs(1-g)): picks the cell's exit angular shape (exit_law.h;
+  /// calibrated scheme only).
+  float reducedAlbedo = 1.0f;
 };
 
 /// The seed's factors (e = exp(-σt Δx), α = σs/σt: dc = e + α(1-e), linear = e + α(1-e)g).

@@ -30,4 +30,10 @@
 
 #define SSLPV_PI 3.14159265358979323846
 
+// The calibrated exit law's table (volume/exit_law.h): rows over t = sqrt(1 - a') at
+// t = k / ALBEDO_INTERVALS, columns over the outside cosine mu_o = j / MU_INTERVALS,
+// row-major, (ALBEDO_INTERVALS + 1) x (MU_INTERVALS + 1) floats, bilinear.
+#define SSLPV_EXIT_LAW_ALBEDO_INTERVALS 32
+#define SSLPV_EXIT_LAW_MU_INTERVALS 64
+
 #endif

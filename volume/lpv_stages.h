@@ -90,6 +90,10 @@ struct StepFactors {
   /// Per channel, per cell: multiplies the exitant radiance shading reads from the cell
   /// (all 1 in the seed scheme).
   std::array<std::vector<float>, 3> exitGain;
+  /// Calibrated scheme: per channel, per cell, the reduced albedo α' that selects the
+  /// cell's exit angular shape in shading (volume/exit_law.h). Empty in the seed scheme,
+  /// whose exit stays Lambertian inside the boundary.
+  std::array<std::vector<float>, 3> reducedAlbedo;
   std::vector<unsigned char> active;  ///< coverage > 0 and not on the outer ring
   /// Per (y, z) row: does it hold any active cell? Rows without one never hold light and
   /// are skipped, so cost follows the object's cells rather than its bounding box.
@@ -115,9 +119,14 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
 /// LPV half a cell inside the surface, converts intensity to exitant radiance through the
 /// hemisphere integral, and applies the exit Fresnel transmittance (and the 1/η² radiance
 /// change across the boundary). Background pixels are 0.
-/// `exitGain` (StepFactors::exitGain) scales each cell's coefficients; empty = 1.
+/// `exitGain` (StepFactors::exitGain) scales each cell's coefficients; null = 1.
+/// `reducedAlbedo` (StepFactors::reducedAlbedo): with it (non-null, non-empty) each cell's
+/// radiance also follows its medium's exit angular shape, exitLawShape(exitLawTable(ior),
+/// α', cos θo), which keeps each cell's total exitant power; null or empty: Lambertian
+/// inside the boundary.
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
                  const ShGrid& accumulated, double ior,
-                 const std::array<std::vector<float>, 3>* exitGain = nullptr);
+                 const std::array<std::vector<float>, 3>* exitGain = nullptr,
+                 const std::array<std::vector<float>, 3>* reducedAlbedo = nullptr);
 
 }  // namespace sslpv

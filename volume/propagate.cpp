@@ -243,6 +243,7 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
     factors.dc[ch].assign(n, 0.0f);
     factors.linear[ch].assign(n, 0.0f);
     factors.exitGain[ch].assign(n, 1.0f);
+    if (scheme == LpvScheme::Calibrated) factors.reducedAlbedo[ch].assign(n, 0.0f);
   }
   factors.active.assign(n, 0);
   factors.rowActive.assign(std::size_t(f.dims.y) * f.dims.z, 0);
@@ -262,6 +263,7 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
           factors.dc[ch][i] = t.dc;
           factors.linear[ch][i] = t.linear;
           factors.exitGain[ch][i] = t.exitGain;
+          if (scheme == LpvScheme::Calibrated) factors.reducedAlbedo[ch][i] = t.reducedAlbedo;
         }
       }
   });

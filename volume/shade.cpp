@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "volume/exit_law.h"
 #include "volume/fresnel.h"
 #include "volume/image_io.h"
 #include "volume/lpv_stages.h"
@@ -15,7 +16,11 @@
 namespace sslpv {
 
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
-                 const ShGrid& accumulated, double ior, const std::array<std::vector<float>, 3>* exitGain) {
+                 const ShGrid& accumulated, double ior, const std::array<std::vector<float>, 3>* exitGain,
+                 const std::array<std::vector<float>, 3>* reducedAlbedo) {
+  // The calibrated exit law weights each cell by its medium's exit shape (exit_law.h).
+  const bool exitLaw = reducedAlbedo != nullptr && !(*reducedAlbedo)[0].empty();
+  const ExitLawTable* law = exitLaw ? &exitLawTable(ior) : nullptr;
   Image image(camera.width, camera.height);
   const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
   const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
@@ -56,9 +61,13 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
         glm::vec3 radiance(0.0f);
         for (int ch = 0; ch < 3; ++ch) {
           sh::Coeffs c(0.0f);
-          for (int i = 0; i < used; ++i)
-            c += weights[i] * (exitGain ? (*exitGain)[ch][cells[i]] : 1.0f) * sh::Coeffs(accumulated.plane(ch, 0)[cells[i]], accumulated.plane(ch, 1)[cells[i]],
-                                         accumulated.plane(ch, 2)[cells[i]], accumulated.plane(ch, 3)[cells[i]]);
+          for (int i = 0; i < used; ++i) {
+            const std::size_t cell = cells[i];
+            float scale = weights[i] * (exitGain ? (*exitGain)[ch][cell] : 1.0f);
+            if (law) scale *= exitLawShape(*law, (*reducedAlbedo)[ch][cell], float(cosOut));
+            c += scale * sh::Coeffs(accumulated.plane(ch, 0)[cell], accumulated.plane(ch, 1)[cell],
+                                    accumulated.plane(ch, 2)[cell], accumulated.plane(ch, 3)[cell]);
+          }
           const double exitant = std::max(0.0f, sh::hemisphereIntegral(c, glm::vec3(n)));
           radiance[ch] = float(exitant * radianceScale * boundaryScale * transmittance);
         }
