@@ -1,5 +1,7 @@
 #include "gpu/vulkan_renderer.h"
 
+#include "volume/lpv_calibration.h"
+
 #include <chrono>
 
 #include "gpu/gpu_inject.h"
@@ -24,6 +26,7 @@ VulkanRenderer::VulkanRenderer(const Scene& scene, const VulkanDevice& device)
   const auto start = std::chrono::steady_clock::now();
   mesh_ = std::make_unique<GpuMesh>(device_, object_.mesh());
   injector_ = std::make_unique<GpuInjector>(device_);
+  prepareCalibrationTables(scene_.material.ior);
   loadMs_ = object_.loadMs() + msSince(start);
 }
 

@@ -1,5 +1,7 @@
 #include "volume/cpu_renderer.h"
 
+#include "volume/lpv_calibration.h"
+
 #include <chrono>
 
 #include "volume/error.h"
@@ -29,6 +31,7 @@ class Stopwatch {
 CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene), object_(scene_) {
   Stopwatch watch;
   rays_ = std::make_unique<RayScene>(object_.mesh());
+  prepareCalibrationTables(scene_.material.ior);
   loadMs_ = object_.loadMs() + watch.lapMs();
 }
 

@@ -112,19 +112,30 @@ const ExitLawTable& exitLawTable(double ior) {
   return *last;
 }
 
-float exitLawShape(const ExitLawTable& table, float reducedAlbedo, float cosOut) {
-  // Keep this line for line with exitLawShape in shaders/shade.comp.
-  const float t = std::sqrt(std::clamp(1.0f - reducedAlbedo, 0.0f, 1.0f)) * float(kAlbedo);
-  const int k = std::min(int(t), kAlbedo - 1);
-  const float ft = t - float(k);
+float exitLawRow(float reducedAlbedo) {
+  return std::sqrt(std::clamp(1.0f - reducedAlbedo, 0.0f, 1.0f)) * float(kAlbedo);
+}
+
+ExitLawColumn exitLawColumn(float cosOut) {
   const float m = std::clamp(cosOut, 0.0f, 1.0f) * float(kMu);
   const int j = std::min(int(m), kMu - 1);
-  const float fm = m - float(j);
-  const float* low = table.shape.data() + std::size_t(k) * (kMu + 1) + std::size_t(j);
+  return {j, m - float(j)};
+}
+
+float exitLawShapeAt(const ExitLawTable& table, float t, ExitLawColumn column) {
+  const int k = std::min(int(t), kAlbedo - 1);
+  const float ft = t - float(k);
+  const float fm = column.fraction;
+  const float* low = table.shape.data() + std::size_t(k) * (kMu + 1) + std::size_t(column.index);
   const float* high = low + (kMu + 1);
   const float a = low[0] + fm * (low[1] - low[0]);
   const float b = high[0] + fm * (high[1] - high[0]);
   return a + ft * (b - a);
+}
+
+float exitLawShape(const ExitLawTable& table, float reducedAlbedo, float cosOut) {
+  // Keep this line for line with exitLawShape in shaders/shade.comp.
+  return exitLawShapeAt(table, exitLawRow(reducedAlbedo), exitLawColumn(cosOut));
 }
 
 double exitRadianceFactor(const ExitLawTable& table, double reducedAlbedo, double cosOut) {

@@ -47,6 +47,18 @@ const ExitLawTable& exitLawTable(double ior);
 /// α' is clamped to [0, 1], cosOut to [0, 1].
 float exitLawShape(const ExitLawTable& table, float reducedAlbedo, float cosOut);
 
+/// exitLawShape in two halves, for shading that reads many cells for one direction: the
+/// table row coordinate of an albedo (one square root, computed once per cell) and the
+/// column of a direction (once per pixel). exitLawShapeAt(table, exitLawRow(a),
+/// exitLawColumn(c)) is bit-identical to exitLawShape(table, a, c).
+struct ExitLawColumn {
+  int index = 0;
+  float fraction = 0.0f;
+};
+float exitLawRow(float reducedAlbedo);
+ExitLawColumn exitLawColumn(float cosOut);
+float exitLawShapeAt(const ExitLawTable& table, float row, ExitLawColumn column);
+
 /// The whole factor the shading applies to a cell's Lambertian radiance inside:
 /// (1 - F(cosOut)) / η² · exitLawShape (without the table: the old law, h = 1).
 double exitRadianceFactor(const ExitLawTable& table, double reducedAlbedo, double cosOut);

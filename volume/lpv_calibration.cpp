@@ -20,6 +20,8 @@
 //    field inside that crosses the boundary).
 #include "volume/lpv_calibration.h"
 
+#include "volume/exit_law.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -151,6 +153,11 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   double gain = latticeReflectance > 0.0 ? target / latticeReflectance : 0.0;
   if (!std::isfinite(gain) || reducedAlbedo <= 0.0) gain = 0.0;
   return {float(survival), 0.0f, float(gain), float(reducedAlbedo)};
+}
+
+void prepareCalibrationTables(double ior) {
+  boundaryReflectance(1.0, ior);
+  exitLawTable(ior);
 }
 
 }  // namespace sslpv

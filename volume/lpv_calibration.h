@@ -79,6 +79,11 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
 /// Throws std::invalid_argument unless ior is positive and finite.
 double boundaryReflectance(double albedo, double ior);
 
+/// Builds the per-ior tables the calibrated scheme uses (boundaryReflectance and the exit
+/// law, ~50 ms together) now, so renderers pay it while loading the object rather than
+/// inside their first frame's stage timings. Throws like boundaryReflectance.
+void prepareCalibrationTables(double ior);
+
 /// The index-matched case boundaryReflectance(albedo, 1): 1 - H(1)·sqrt(1 - albedo), as
 /// exactIsotropicRd (volume/slab_reflectance.h) computes it from the H-function.
 double halfSpaceReflectance(double albedo);

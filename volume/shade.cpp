@@ -21,6 +21,17 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
   // The calibrated exit law weights each cell by its medium's exit shape (exit_law.h).
   const bool exitLaw = reducedAlbedo != nullptr && !(*reducedAlbedo)[0].empty();
   const ExitLawTable* law = exitLaw ? &exitLawTable(ior) : nullptr;
+  // Each cell's table row once per frame, not once per pixel that reads it (8 cells x 3
+  // channels a pixel): the square root dominated the shading time.
+  std::array<std::vector<float>, 3> lawRow;
+  if (law)
+    for (int ch = 0; ch < 3; ++ch) {
+      const std::vector<float>& albedo = (*reducedAlbedo)[ch];
+      lawRow[ch].resize(albedo.size());
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, albedo.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i) lawRow[ch][i] = exitLawRow(albedo[i]);
+      });
+    }
   Image image(camera.width, camera.height);
   const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
   const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
@@ -58,13 +69,14 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
         if (used == 0) used = activeTrilinearWeights(material, p - cellSize * n, cells, weights);
         if (used == 0) continue;
         const double transmittance = 1.0 - fresnelReflectance(cosOut, ior);
+        const ExitLawColumn column = exitLawColumn(float(cosOut));
         glm::vec3 radiance(0.0f);
         for (int ch = 0; ch < 3; ++ch) {
           sh::Coeffs c(0.0f);
           for (int i = 0; i < used; ++i) {
             const std::size_t cell = cells[i];
             float scale = weights[i] * (exitGain ? (*exitGain)[ch][cell] : 1.0f);
-            if (law) scale *= exitLawShape(*law, (*reducedAlbedo)[ch][cell], float(cosOut));
+            if (law) scale *= exitLawShapeAt(*law, lawRow[ch][cell], column);
             c += scale * sh::Coeffs(accumulated.plane(ch, 0)[cell], accumulated.plane(ch, 1)[cell],
                                     accumulated.plane(ch, 2)[cell], accumulated.plane(ch, 3)[cell]);
           }
