@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "volume/image_metrics.h"
 #include "editor/edit_session.h"
 #include "volume/error.h"
 
@@ -62,19 +63,6 @@ struct Row {
   std::size_t gridCells = 0;
 };
 
-/// Largest per-channel |a - b| / |b| (|b| floored at 1e-6 of b's peak).
-double maxRelativeDifference(const Image& a, const Image& b) {
-  if (a.width != b.width || a.height != b.height) return INFINITY;
-  float peak = 0.0f;
-  for (const glm::vec3& p : b.pixels) peak = std::max({peak, p.r, p.g, p.b});
-  double worst = 0.0;
-  for (std::size_t i = 0; i < a.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const double ref = b.pixels[i][c];
-      worst = std::max(worst, std::abs(double(a.pixels[i][c]) - ref) / std::max(std::abs(ref), 1e-6 * peak));
-    }
-  return worst;
-}
 
 template <class F>
 double medianOf(const std::vector<Run>& runs, F field) {

@@ -112,12 +112,8 @@ PaintTarget makePaintTarget(const Scene& scene) {
   target.worldMesh = std::make_shared<const TriangleMesh>(std::move(mesh));
   if (scene.material.vdb) {
     const std::shared_ptr<const MaterialSet> loaded = loadMaterialSet(*scene.material.vdb);
-    auto set = std::make_shared<MaterialSet>(*loaded);
     // The loaded grids may be shared (and are const): paint copies.
-    set->sigmaT = loaded->sigmaT->deepCopy();
-    set->sigmaS = loaded->sigmaS->deepCopy();
-    if (loaded->g) set->g = loaded->g->deepCopy();
-    target.set = std::move(set);
+    target.set = deepCopy(*loaded);
   } else {
     const glm::dvec3 extent = target.restBounds.extent();
     const double voxel = std::max(extent.x, std::max(extent.y, extent.z)) / kDefaultVoxelsPerExtent;

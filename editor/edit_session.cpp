@@ -399,12 +399,8 @@ void EditSession::recover() {
     throw InputError(file.string() + ": " + message);
   }
   // Painting needs its own grids: the loaded ones are const and may be shared.
-  auto set = std::make_shared<MaterialSet>(*loaded);
-  set->sigmaT = loaded->sigmaT->deepCopy();
-  set->sigmaS = loaded->sigmaS->deepCopy();
-  if (loaded->g) set->g = loaded->g->deepCopy();
   PaintTarget target = m.targetTemplate;
-  target.set = std::move(set);
+  target.set = deepCopy(*loaded);
   std::unique_ptr<BrushEngine> engine;
   try {
     engine = std::make_unique<BrushEngine>(std::move(target));

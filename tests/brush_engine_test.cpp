@@ -54,15 +54,6 @@ Voxel voxel(const MaterialSet& set, const Coord& c) {
   return v;
 }
 
-/// A deep copy, so later painting does not change it.
-std::shared_ptr<MaterialSet> copyOf(const MaterialSet& set) {
-  auto copy = std::make_shared<MaterialSet>(set);
-  copy->sigmaT = set.sigmaT->deepCopy();
-  copy->sigmaS = set.sigmaS->deepCopy();
-  if (set.g) copy->g = set.g->deepCopy();
-  return copy;
-}
-
 openvdb::CoordBBox dataBox(const MaterialSet& a, const MaterialSet& b) {
   openvdb::CoordBBox box;
   auto addLeaves = [&box](const auto& tree) {
@@ -209,7 +200,7 @@ TEST(BrushEngine, EveryModeLeavesVoxelsOutsideTheStrokeBitIdenticalAndCountsWhat
   const glm::dvec3 a(-2.1, 0.3, 1.0), b(2.4, -1.0, 0.6);
   for (const Brush& brush : brushes) {
     auto set = randomSet(7);
-    const auto before = copyOf(*set);
+    const auto before = deepCopy(*set);
     auto engine = makeEngine(set);
     const StrokeResult result = engine->applyStroke({brush, {a, b}, {}});
     std::size_t differing = 0;
@@ -259,7 +250,7 @@ TEST(BrushEngine, UndoAndRedoRestoreBitIdenticallyInterleaved) {
   // drops the redo branch, and history memory grows with the strokes.
   auto set = randomSet(11);
   auto engine = makeEngine(set);
-  std::vector<std::shared_ptr<MaterialSet>> states{copyOf(*set)};
+  std::vector<std::shared_ptr<MaterialSet>> states{deepCopy(*set)};
   Brush a = makeBrush(BrushChannel::SigmaT, BrushMode::Set, 2.0, BrushFalloff::Gaussian, 0.9);
   a.rgb = glm::dvec3(9, 0.1, 3);
   Brush b = makeBrush(BrushChannel::All, BrushMode::Smooth, 2.5, BrushFalloff::Smooth, 1.0);
@@ -267,7 +258,7 @@ TEST(BrushEngine, UndoAndRedoRestoreBitIdenticallyInterleaved) {
   std::vector<StrokeResult> results;
   for (const Brush& brush : {a, b, c}) {
     results.push_back(engine->applyStroke({brush, {glm::dvec3(-1, 0, 0), glm::dvec3(1.5, 1, 0)}, {}}));
-    states.push_back(copyOf(*set));
+    states.push_back(deepCopy(*set));
     EXPECT_FALSE(sameVoxels(*states.back(), *states[states.size() - 2]));
   }
   const std::size_t bytesAfterThree = engine->historyBytes();
@@ -287,7 +278,7 @@ TEST(BrushEngine, UndoAndRedoRestoreBitIdenticallyInterleaved) {
   Brush d = makeBrush(BrushChannel::G, BrushMode::Add, 3.0, BrushFalloff::Constant, 0.5);
   d.scalar = 0.7;
   engine->applyStroke({d, {glm::dvec3(0.5)}, {}});
-  const auto afterD = copyOf(*set);
+  const auto afterD = deepCopy(*set);
   EXPECT_FALSE(engine->canRedo());
   EXPECT_EQ(engine->historyStrokes(), 2u);
   engine->undo();
@@ -449,7 +440,7 @@ TEST(BrushEngine, IncrementalStrokeEqualsTheWholeStroke) {
   for (const auto& part : {std::vector<glm::dvec3>(points.begin(), points.begin() + 2),
                            std::vector<glm::dvec3>(points.begin() + 2, points.begin() + 3),
                            std::vector<glm::dvec3>(points.begin() + 3, points.end())}) {
-    const auto before = copyOf(*pieces);
+    const auto before = deepCopy(*pieces);
     const DabResult call = engine->addPoints(part);
     dabs += call.dabs;
     for (auto it = dataBox(*pieces, *before).begin(); it; ++it) {

@@ -2,6 +2,7 @@
 // history position, save/export/autosave write atomically and a failed write changes
 // nothing, crash recovery restores the painted voxels bit for bit, and the incremental
 // preview equals a full render of the saved scene. Each test states what it checks.
+#include "volume/image_metrics.h"
 #include "editor/edit_session.h"
 
 #include <gtest/gtest.h>
@@ -81,14 +82,6 @@ template <class GridT>
   return sameGrid(a.g.get(), b.g.get(), "g");
 }
 
-std::shared_ptr<MaterialSet> copyOf(const MaterialSet& set) {
-  auto copy = std::make_shared<MaterialSet>(set);
-  copy->sigmaT = set.sigmaT->deepCopy();
-  copy->sigmaS = set.sigmaS->deepCopy();
-  if (set.g) copy->g = set.g->deepCopy();
-  return copy;
-}
-
 std::vector<std::string> listDir(const fs::path& dir) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
@@ -96,21 +89,6 @@ std::vector<std::string> listDir(const fs::path& dir) {
   return names;
 }
 
-/// Largest per-channel |a - b| / |b| over the image (|b| floored at 1e-6 of b's peak, so
-/// black background pixels compare absolutely).
-double maxRelativeDifference(const Image& a, const Image& b) {
-  if (a.width != b.width || a.height != b.height) return INFINITY;
-  float peak = 0.0f;
-  for (const glm::vec3& p : b.pixels) peak = std::max({peak, p.r, p.g, p.b});
-  double worst = 0.0;
-  for (std::size_t i = 0; i < a.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const double ref = b.pixels[i][c];
-      const double d = std::abs(double(a.pixels[i][c]) - ref) / std::max(std::abs(ref), 1e-6 * peak);
-      worst = std::max(worst, std::isfinite(d) ? d : INFINITY);
-    }
-  return worst;
-}
 
 /// A full render of `sceneFile` by a fresh CPU renderer, at the session's preview view.
 Image freshRender(const fs::path& sceneFile, const EditSession& session) {
@@ -246,7 +224,7 @@ void expectFailedSaveChangesNothing(EditSession& s, const fs::path& named, const
   std::vector<std::string> before;
   for (const fs::path& file : files) before.push_back(readText(file));
   const bool couldUndo = s.canUndo();
-  const auto voxels = copyOf(*s.engine().materialSet());
+  const auto voxels = deepCopy(*s.engine().materialSet());
   try {
     s.save();
     ADD_FAILURE() << "save() succeeded although " << named << " could not be written";
@@ -409,7 +387,7 @@ TEST(EditSession, UnusableRecoveryFileIsAnInputErrorAndChangesNothing) {
   Files f;
   EditSession s(f.scene, smallPreview());
   s.applyStroke(darkStroke());
-  const auto voxels = copyOf(*s.engine().materialSet());
+  const auto voxels = deepCopy(*s.engine().materialSet());
   const fs::path recovery = f.dir / "scene.json.recovery.vdb";
 
   auto expectUnchanged = [&](const char* what) {
@@ -426,7 +404,7 @@ TEST(EditSession, UnusableRecoveryFileIsAnInputErrorAndChangesNothing) {
   writeText(recovery, "not a vdb file, the previous session crashed while writing it?");
   expectUnchanged("garbage");
 
-  auto mismatched = copyOf(*voxels);
+  auto mismatched = deepCopy(*voxels);
   mismatched->sigmaS->setTransform(openvdb::math::Transform::createLinearTransform(0.37));
   saveMaterialSet(*mismatched, recovery);
   ASSERT_NO_THROW(loadMaterialSet(recovery)) << "the file itself must be valid for this case";

@@ -256,4 +256,18 @@ std::string compareJson(const CompareSource& source, const ImageMetrics& m) {
   return record.dump(2) + "\n";
 }
 
+double maxRelativeDifference(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height) return INFINITY;
+  float peak = 0.0f;
+  for (const glm::vec3& p : b.pixels) peak = std::max({peak, p.r, p.g, p.b});
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double ref = b.pixels[i][c];
+      const double d = std::abs(double(a.pixels[i][c]) - ref) / std::max(std::abs(ref), 1e-6 * peak);
+      worst = std::max(worst, std::isfinite(d) ? d : INFINITY);
+    }
+  return worst;
+}
+
 }  // namespace sslpv

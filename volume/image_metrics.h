@@ -90,6 +90,11 @@ PixelMask blockMask(const PixelMask& mask, int k);
 /// mask, range > 0.
 double ssim(const Image& a, const Image& b, const PixelMask& mask, double range);
 
+/// Largest per-channel |a - b| / |b| over the whole image (|b| floored at 1e-6 of b's
+/// peak, so black background pixels compare absolutely); infinity for different sizes or
+/// a non-finite pixel. For "these two renders are the same frame" checks.
+double maxRelativeDifference(const Image& a, const Image& b);
+
 struct ImageMetrics {
   int width = 0, height = 0;   ///< of the images the metrics were computed on
   std::size_t maskPixels = 0;  ///< pixels (or blocks) in the mask

@@ -397,4 +397,12 @@ bool inspectVdbFile(const fs::path& file, std::ostream& report) {
   return false;
 }
 
+std::shared_ptr<MaterialSet> deepCopy(const MaterialSet& set) {
+  auto copy = std::make_shared<MaterialSet>(set);
+  copy->sigmaT = set.sigmaT->deepCopy();
+  copy->sigmaS = set.sigmaS->deepCopy();
+  if (set.g) copy->g = set.g->deepCopy();
+  return copy;
+}
+
 }  // namespace sslpv

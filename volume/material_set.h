@@ -62,6 +62,9 @@ std::vector<ValidationProblem> validateMaterialSet(const MaterialSet& set,
 /// Does not validate the values, so tests and tools can write invalid files on purpose.
 void saveMaterialSet(const MaterialSet& set, const std::filesystem::path& file);
 
+/// A copy with its own grids (deep): painting it leaves `set`, which may be shared, as it was.
+std::shared_ptr<MaterialSet> deepCopy(const MaterialSet& set);
+
 /// Human-readable report for `sslpv inspect`: grids, types, active voxel counts, value
 /// ranges, transforms, metadata and every validation problem. Returns false when the
 /// file has problems (the report then lists them). Throws InputError when unreadable.
