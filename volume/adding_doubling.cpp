@@ -315,4 +315,18 @@ double diffuseBoundaryTransmittance(double eta) {
   return sum;
 }
 
+double diffusionBoundaryCoefficient(double eta) {
+  if (!(eta > 0.0) || !std::isfinite(eta))
+    throw std::invalid_argument("diffusionBoundaryCoefficient: eta must be positive");
+  std::vector<double> mu, w;
+  boundaryQuadrature(64, eta, mu, w);
+  double twoC1 = 0.0, threeC2 = 0.0;
+  for (std::size_t i = 0; i < mu.size(); ++i) {
+    const double reflected = internalFresnel(mu[i], eta);
+    twoC1 += 2.0 * w[i] * mu[i] * reflected;
+    threeC2 += 3.0 * w[i] * mu[i] * mu[i] * reflected;
+  }
+  return (1.0 + threeC2) / (1.0 - twoC1);
+}
+
 }  // namespace sslpv

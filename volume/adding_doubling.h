@@ -70,4 +70,10 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
 /// Fresnel reflectance, total internal reflection included; = (1 - F̄_outside) / η².
 double diffuseBoundaryTransmittance(double eta);
 
+/// The diffusion boundary coefficient A = (1 + 3 C2) / (1 - 2 C1) of a smooth boundary of
+/// relative index `eta`, from the internal Fresnel moments 2 C1 = ∫ 2μ F dμ and
+/// 3 C2 = ∫ 3μ² F dμ (d'Eon and Irving 2011): the diffuse field's extrapolation length is
+/// 2 A D. 1 at eta = 1. Throws std::invalid_argument unless eta is positive and finite.
+double diffusionBoundaryCoefficient(double eta);
+
 }  // namespace sslpv
