@@ -7,7 +7,7 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 4;  // see the bindings of shaders/lpv_inject.comp
+constexpr std::uint32_t kBindings = 5;  // see the bindings of shaders/lpv_inject.comp
 constexpr VkDeviceSize kVec4 = 4 * sizeof(float);
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
@@ -70,6 +70,17 @@ Buffer uploadCellCoverage(const VulkanDevice& device, const MaterialGrid& materi
   return uploadBytes(device, values.data(), values.size() * sizeof(float));
 }
 
+Buffer uploadInjectionDepths(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame) {
+  const std::size_t cells = frame.cellCount();
+  for (int ch = 0; ch < 3; ++ch)
+    if (factors.injectionDepth[ch].size() != cells)
+      throw GpuError("uploadInjectionDepths: the step factors hold no injection depths for this grid frame");
+  std::vector<float> values(cells * 4, 0.0f);
+  for (std::size_t i = 0; i < cells; ++i)
+    for (int ch = 0; ch < 3; ++ch) values[4 * i + std::size_t(ch)] = factors.injectionDepth[ch][i];
+  return uploadBytes(device, values.data(), values.size() * sizeof(float));
+}
+
 Buffer uploadFluxSamples(const VulkanDevice& device, const std::vector<GpuFluxSample>& samples) {
   return uploadBytes(device, samples.data(), samples.size() * sizeof(GpuFluxSample));
 }
@@ -96,11 +107,13 @@ GpuInjector::GpuInjector(const VulkanDevice& device, const GpuInjectorOptions& o
   partials_ =
       Buffer(device, VkDeviceSize(options_.maxWorkgroups) * SSLPV_INJECT_STATS_VEC4 * kVec4, kStorage, MemoryUse::Host);
   sets_.write(0, 3, partials_);
+  noDepths_ = Buffer(device, kVec4, kStorage, MemoryUse::Device);
   timestamps_ = TimestampQueries(device, 2);
 }
 
 void GpuInjector::record(VkCommandBuffer cmd, const Buffer& samples, std::uint32_t sampleCount,
-                         const Buffer& cellCoverage, const GridFrame& frame, const Buffer& field, bool clearField) {
+                         const Buffer& cellCoverage, const GridFrame& frame, const Buffer& field, bool clearField,
+                         const Buffer* injectionDepths) {
   const std::size_t cells = frame.cellCount();
   if (cells == 0) throw GpuError("GpuInjector::record: the grid frame has no cells");
   // Field offsets are 12 * cell as 32-bit indices in the shader.
@@ -108,11 +121,13 @@ void GpuInjector::record(VkCommandBuffer cmd, const Buffer& samples, std::uint32
   requireBytes(samples, VkDeviceSize(sampleCount) * sizeof(GpuFluxSample), "sample");
   requireBytes(cellCoverage, VkDeviceSize(cells) * sizeof(float), "cell coverage");
   requireBytes(field, lightFieldBytes(frame), "light field");
+  if (injectionDepths != nullptr) requireBytes(*injectionDepths, VkDeviceSize(cells) * kVec4, "injection depth");
 
   // Rewritten every recording, hence one recording in flight per injector (see the class).
   sets_.write(0, 0, samples);
   sets_.write(0, 1, cellCoverage);
   sets_.write(0, 2, field);
+  sets_.write(0, 4, injectionDepths != nullptr ? *injectionDepths : noDepths_);
 
   InjectPush push{};
   push.gridOriginX = float(frame.origin.x);
@@ -123,6 +138,7 @@ void GpuInjector::record(VkCommandBuffer cmd, const Buffer& samples, std::uint32
   push.gridDimsY = frame.dims.y;
   push.gridDimsZ = frame.dims.z;
   push.sampleCount = sampleCount;
+  push.calibrated = injectionDepths != nullptr ? 1u : 0u;
 
   deviceWritesBarrier(cmd);  // samples, coverage or field written earlier on the queue
   if (clearField) {
@@ -152,11 +168,12 @@ InjectionStats GpuInjector::stats() const {
 }
 
 InjectionStats GpuInjector::run(const Buffer& samples, std::uint32_t sampleCount, const Buffer& cellCoverage,
-                                const GridFrame& frame, const Buffer& field, bool clearField) {
+                                const GridFrame& frame, const Buffer& field, bool clearField,
+                                const Buffer* injectionDepths) {
   VkCommandBuffer cmd = commands_.begin();
   timestamps_.reset(cmd);
   timestamps_.write(cmd, 0);
-  record(cmd, samples, sampleCount, cellCoverage, frame, field, clearField);
+  record(cmd, samples, sampleCount, cellCoverage, frame, field, clearField, injectionDepths);
   timestamps_.write(cmd, 1);
   commands_.submitAndWait();
   lastRunMs_ = timestamps_.readMilliseconds(2)[1];

@@ -19,7 +19,7 @@ constexpr std::uint32_t kBindings = 11;
 constexpr bool kTexelBinding[kBindings] = {true, false, false, true, true, false, false, false, false, true, false};
 constexpr VkDeviceSize kVec4 = 4 * sizeof(float);
 constexpr VkDeviceSize kFieldVec4PerCell = 3;   // one vec4 of (c0, c1x, c1y, c1z) per channel
-constexpr VkDeviceSize kFactorVec4PerCell = 2;  // (dc.rgb, active), (linear.rgb, 0)
+constexpr VkDeviceSize kFactorVec4PerCell = 3;  // (dc.rgb, active), (linear.rgb, 0), (retention.rgb, 0)
 constexpr VkDeviceSize kEnergyRowBytes = SSLPV_ENERGY_FLOATS * sizeof(float);
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
@@ -341,7 +341,8 @@ void GpuPropagator::writeDescriptors() {
 void GpuPropagator::setFactors(const StepFactors& factors) {
   const std::size_t cells = frame_.cellCount();
   for (int ch = 0; ch < 3; ++ch)
-    if (factors.dc[ch].size() != cells || factors.linear[ch].size() != cells)
+    if (factors.dc[ch].size() != cells || factors.linear[ch].size() != cells ||
+        (!factors.retention[ch].empty() && factors.retention[ch].size() != cells))
       throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
   if (factors.active.size() != cells || factors.rowActive.size() != std::size_t(frame_.dims.y) * frame_.dims.z)
     throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
@@ -355,9 +356,11 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
         for (int ch = 0; ch < 3; ++ch) {
           cell[ch] = factors.dc[ch][i];
           cell[4 + ch] = factors.linear[ch][i];
+          cell[8 + ch] = factors.retention[ch].empty() ? 0.0f : factors.retention[ch][i];
         }
         cell[3] = factors.active[i] ? 1.0f : 0.0f;
         cell[7] = 0.0f;
+        cell[11] = 0.0f;
       }
   });
   if (staging_) {

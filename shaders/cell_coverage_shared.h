@@ -42,7 +42,8 @@ namespace sslpv::gpu {
 /// Push constants of shaders/lpv_inject.comp.
 #define SSLPV_INJECT_PUSH_FIELDS(X) \
   SSLPV_CELL_GRID_FIELDS(X)         \
-  X(SSLPV_CC_UINT, sampleCount) /* GpuFluxSample records to read */
+  X(SSLPV_CC_UINT, sampleCount) /* GpuFluxSample records to read */ \
+  X(SSLPV_CC_UINT, calibrated)  /* 1: isotropic sources at the injection depths (binding 4) */
 
 struct InjectPush {
   SSLPV_INJECT_PUSH_FIELDS(SSLPV_CC_DECLARE_FIELD)
@@ -55,7 +56,7 @@ struct InjectPush {
 
 #ifdef __cplusplus
 }  // namespace sslpv::gpu
-static_assert(sizeof(sslpv::gpu::InjectPush) == 8 * 4, "InjectPush must be 4-byte scalars only");
+static_assert(sizeof(sslpv::gpu::InjectPush) == 9 * 4, "InjectPush must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::InjectPush, gridDimsX) == 4 * 4, "InjectPush field order");
 static_assert(offsetof(sslpv::gpu::InjectPush, sampleCount) == 7 * 4, "InjectPush field order");
 #endif

@@ -1,8 +1,11 @@
 #version 460
 // Injection: the twin of sslpv::injectSamples (volume/inject.cpp). Each GpuFluxSample
-// that hit the object adds a clamped cosine lobe holding flux/π about its refracted
-// direction, half a cell inside the surface (a full cell deeper when no active cell is
-// near), spread over active cells with activeTrilinearWeights. Neighbouring samples
+// that hit the object adds, in the seed scheme, a clamped cosine lobe holding flux/π about
+// its refracted direction, half a cell inside the surface (a full cell deeper when no
+// active cell is near), spread over active cells with activeTrilinearWeights; in the
+// calibrated scheme (push.calibrated) per channel an isotropic source of the same power at
+// max(depth cos θt, Δx / 2) along the inward normal, the depth read from the surface
+// cell's entry of binding 4 and θt the refracted direction's angle to the normal. Neighbouring samples
 // write the same cells, so the lobes are added with float atomics. Each workgroup also
 // sums the injected and dropped flux of its samples into one row of partial sums, which
 // the host adds in double.
@@ -24,6 +27,9 @@ layout(std430, binding = 0) readonly buffer Samples { GpuFluxSample samples[]; }
 // c1y, c1z), as 12 floats so that each coefficient can be added atomically.
 layout(std430, binding = 2) buffer Field { float field[]; };
 layout(std430, binding = 3) writeonly buffer Stats { vec4 partials[]; };
+// Per cell, x-fastest: (injection depth rgb, 0) of the calibrated scheme
+// (StepFactors::injectionDepth); unread in the seed scheme.
+layout(std430, binding = 4) readonly buffer Depths { vec4 injectionDepth[]; };
 
 shared vec4 injectedSums[SSLPV_INJECT_GROUP];
 shared vec4 droppedSums[SSLPV_INJECT_GROUP];
@@ -48,13 +54,39 @@ void main() {
       dropped += rec.flux.rgb;
       continue;
     }
-    for (int ch = 0; ch < 3; ++ch) {
-      // A Lambertian emitter of power Φ has intensity (Φ/π) max(0, cos).
-      const vec4 lobe = vec4(float(SSLPV_COSINE_LOBE_C0), float(SSLPV_COSINE_LOBE_C1) * rec.direction.xyz) *
-                        (rec.flux[ch] / float(SSLPV_PI));
-      for (int i = 0; i < used; ++i) {
-        const uint base = 12u * cells[i] + 4u * uint(ch);
-        for (int k = 0; k < 4; ++k) atomicAdd(field[base + uint(k)], weights[i] * lobe[k]);
+    if (push.calibrated == 0u) {
+      for (int ch = 0; ch < 3; ++ch) {
+        // A Lambertian emitter of power Φ has intensity (Φ/π) max(0, cos).
+        const vec4 lobe = vec4(float(SSLPV_COSINE_LOBE_C0), float(SSLPV_COSINE_LOBE_C1) * rec.direction.xyz) *
+                          (rec.flux[ch] / float(SSLPV_PI));
+        for (int i = 0; i < used; ++i) {
+          const uint base = 12u * cells[i] + 4u * uint(ch);
+          for (int k = 0; k < 4; ++k) atomicAdd(field[base + uint(k)], weights[i] * lobe[k]);
+        }
+      }
+    } else {
+      // The surface cell: the largest weight, the first of equals (as depthCell).
+      int surface = 0;
+      for (int i = 1; i < used; ++i)
+        if (weights[i] > weights[surface]) surface = i;
+      // The refracted beam first scatters about the depth along its path (inject.cpp).
+      const float cosRefracted = max(0.0, -dot(rec.direction.xyz, n));
+      const vec3 depths = max(vec3(halfCell), injectionDepth[cells[surface]].xyz * cosRefracted);
+      for (int ch = 0; ch < 3; ++ch) {
+        uint deepCells[8];
+        float deepWeights[8];
+        int deepUsed = activeTrilinearWeights(grid, p - depths[ch] * n, deepCells, deepWeights);
+        if (deepUsed == 0)
+          deepUsed = activeTrilinearWeights(grid, p - (depths[ch] + halfCell) * n, deepCells, deepWeights);
+        // Deeper than the object is thick: keep the light where it entered.
+        if (deepUsed == 0) {
+          deepUsed = used;
+          deepCells = cells;
+          deepWeights = weights;
+        }
+        // Isotropic with power Φ: the c0 of a cosine lobe of power Φ, no linear band.
+        const float c0 = float(SSLPV_COSINE_LOBE_C0) * rec.flux[ch] / float(SSLPV_PI);
+        for (int i = 0; i < deepUsed; ++i) atomicAdd(field[12u * deepCells[i] + 4u * uint(ch)], deepWeights[i] * c0);
       }
     }
     injected += rec.flux.rgb;

@@ -83,8 +83,8 @@ Cell fetchHalo(ivec2 origin, int lane, int h, int z) {
 void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
   if (!interiorXY(x, y)) return;  // also outside the grid; the ring never holds light
   const int i = cellIndex(x, y, z);
-  const vec4 dc = texelFetch(factors, 2 * i);
-  const vec4 linear = texelFetch(factors, 2 * i + 1);
+  const vec4 dc = texelFetch(factors, 3 * i);
+  const vec4 linear = texelFetch(factors, 3 * i + 1);
   const float on = dc.w;
   vec4 value[3];
   for (int ch = 0; ch < 3; ++ch) {
@@ -101,6 +101,13 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
     for (int ch = 0; ch < 3; ++ch)
       accumulated[3 * i + ch] = keep * texelFetch(accumulatedIn, 3 * i + ch) + texelFetch(sourceField, 3 * i + ch) + value[ch];
   }
+}
+
+/// ρ times the outside neighbours of cell (x, y, z), per channel; zero outside the grid
+/// (branch-free like fetchSource).
+vec3 fetchRetention(int x, int y, int z) {
+  const bool valid = inGrid(x, y, z);
+  return valid ? texelFetch(factors, 3 * cellIndex(valid ? x : 0, valid ? y : 0, valid ? z : 0) + 2).xyz : vec3(0.0);
 }
 
 Gathered nothing() { return Gathered(vec4[3](vec4(0.0), vec4(0.0), vec4(0.0))); }
@@ -154,7 +161,11 @@ void main() {
       }
       [[unroll]] for (int r = 0; r < ROWS; ++r) {
         const CellLobes lobes = emitCell(fetchSource(x, origin.y + r, s), r < ROWS ? owns : 0.0, sums);
+        // The boundary returns ρ per outside neighbour of what the cell sends one
+        // neighbour (its cells are isotropic in the calibrated scheme; 0 in the seed's).
+        const vec3 retention = fetchRetention(x, origin.y + r, s);
         for (int ch = 0; ch < 3; ++ch) {
+          next[r].c[ch].x += retention[ch] * lobes.ch[ch].toward[PLUS_X].x;
           const vec4 fromLeftLane = subgroupShuffleUp(lobes.ch[ch].toward[PLUS_X], 1);
           const vec4 fromRightLane = subgroupShuffleDown(lobes.ch[ch].toward[MINUS_X], 1);
           next[r].c[ch] += (lane > 0 ? fromLeftLane : vec4(0.0)) + (lane < W - 1 ? fromRightLane : vec4(0.0));

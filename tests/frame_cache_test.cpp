@@ -51,7 +51,9 @@ TEST(StageDirty, EachChangeMarksItsFirstStageAndEverythingDownstream) {
   ASSERT_TRUE(dirty.resampleRegion());
   EXPECT_EQ(dirty.resampleRegion()->min, glm::dvec3(0));
   EXPECT_EQ(dirty.resampleRegion()->max, glm::dvec3(6)) << "two strokes before a frame: their union";
-  EXPECT_FALSE(dirty.dirty(Stage::ShadowMap) || dirty.dirty(Stage::Injection));
+  EXPECT_FALSE(dirty.dirty(Stage::ShadowMap) || dirty.dirty(Stage::Voxelize));
+  // The calibrated injection depth follows the material: injection onwards rerun.
+  EXPECT_TRUE(dirty.dirty(Stage::Injection) && dirty.dirty(Stage::Propagation) && dirty.dirty(Stage::Shading));
   dirty.materialChanged(std::nullopt);
   EXPECT_FALSE(dirty.resampleRegion()) << "a whole-material change wins over a region";
   dirty.clear();
@@ -155,7 +157,8 @@ TEST(CpuFrameCache, BrushStrokeResamplesOnlyItsRegionAndMatchesAFullResample) {
   EXPECT_GT(report.resampledCells, 0u);
   EXPECT_LT(report.resampledCells, first.frame.cellCount() / 10) << "a small stroke resamples a small region";
   EXPECT_TRUE(report.times.cached(Stage::ShadowMap));
-  EXPECT_TRUE(report.times.cached(Stage::Injection));
+  // The calibrated injection depth follows the material.
+  EXPECT_FALSE(report.times.cached(Stage::Injection));
   EXPECT_FALSE(report.times.cached(Stage::Propagation));
 
   CpuRenderer fresh(scene);

@@ -40,8 +40,9 @@ TEST(Propagation, IsotropicFieldIsConservedExactly) {
 }
 
 /// Runs `steps` steps from a lobe in the middle of an n³ grid with energy recording.
-PropagationResult runFromLobe(const MaterialGrid& material, int steps, glm::vec3 dir, ShGrid* out = nullptr) {
-  const StepFactors factors = computeStepFactors(material);
+PropagationResult runFromLobe(const MaterialGrid& material, int steps, glm::vec3 dir, ShGrid* out = nullptr,
+                              LpvScheme scheme = LpvScheme::Seed) {
+  const StepFactors factors = computeStepFactors(material, scheme, 1.4);
   ShGrid field, accumulated;
   field.resize(material.frame);
   accumulated.resize(material.frame);
@@ -87,6 +88,59 @@ TEST(Propagation, AbsorptionRemovesEnergyAndTheBalanceStillCloses) {
   }
   for (int ch = 0; ch < 3; ++ch) EXPECT_LT(r.energy.back().inGrid[ch] + left[ch], 0.99 * r.initialPower[ch]);
   EXPECT_GT(absorbed.z, absorbed.x) << "the lowest albedo channel absorbs most";
+}
+
+TEST(Propagation, CalibratedRetentionKeepsTheBalanceAndHoldsLightLonger) {
+  // The calibrated boundary returns part of what boundary cells send outside: the balance
+  // grid + left + absorbed = injected still closes every step (the returned light counts
+  // as gathered), and less light leaves than through the seed's lossy boundary.
+  MaterialGrid material = uniformMaterial(10, glm::vec3(1.0f), glm::vec3(1.0f, 0.98f, 0.9f), 0.0f, 0.5);
+  const PropagationResult calibrated =
+      runFromLobe(material, 60, glm::vec3(0, 0, 1), nullptr, LpvScheme::Calibrated);
+  ASSERT_EQ(calibrated.energy.size(), 60u);
+  glm::dvec3 left(0.0), absorbed(0.0);
+  for (const StepEnergy& e : calibrated.energy) {
+    left += e.left;
+    absorbed += e.absorbed;
+    for (int ch = 0; ch < 3; ++ch) {
+      EXPECT_NEAR(e.inGrid[ch] + left[ch] + absorbed[ch], calibrated.initialPower[ch],
+                  1e-5 * calibrated.initialPower[ch]);
+      EXPECT_GE(e.left[ch], -1e-6 * calibrated.initialPower[ch]);
+    }
+  }
+  EXPECT_EQ(absorbed.x, 0.0) << "albedo 1 absorbs nothing";
+  EXPECT_GT(left.x, 0.05 * calibrated.initialPower.x) << "light must still leave";
+  // Without retention (ρ = 0 everywhere) the same lattice lets more out.
+  StepFactors lossy = computeStepFactors(material, LpvScheme::Calibrated, 1.4);
+  for (int ch = 0; ch < 3; ++ch) std::fill(lossy.retention[ch].begin(), lossy.retention[ch].end(), 0.0f);
+  ShGrid field, accumulated;
+  field.resize(material.frame);
+  accumulated.resize(material.frame);
+  putLobe(field, 5, 5, 5, glm::vec3(0, 0, 1), 1.0f);
+  PropagationOptions options;
+  options.steps = 60;
+  options.recordEnergy = true;
+  const PropagationResult bare = propagate(material, lossy, field, accumulated, options);
+  glm::dvec3 bareLeft(0.0);
+  for (const StepEnergy& e : bare.energy) bareLeft += e.left;
+  EXPECT_GT(bareLeft.x, left.x * 1.05);
+}
+
+TEST(Propagation, RetentionCountsTheOutsideNeighbours) {
+  // A 4³ block of active cells: corners have 3 outside neighbours, edges 2, faces 1, the
+  // inner 2³ none.
+  const MaterialGrid m = uniformMaterial(6, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f, 0.25);
+  const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.5);
+  const float rho = calibratedTransport(1.0, 0.9, 0.0, 0.25, 1.5).retention;
+  ASSERT_GT(rho, 0.0f);
+  for (int z = 1; z <= 4; ++z)
+    for (int y = 1; y <= 4; ++y)
+      for (int x = 1; x <= 4; ++x) {
+        const int outside = (x == 1 || x == 4) + (y == 1 || y == 4) + (z == 1 || z == 4);
+        for (int ch = 0; ch < 3; ++ch)
+          ASSERT_FLOAT_EQ(f.retention[ch][m.frame.index(x, y, z)], float(outside) * rho) << x << y << z;
+      }
+  EXPECT_TRUE(computeStepFactors(m, LpvScheme::Seed, 1.5).retention[0].empty());
 }
 
 TEST(Propagation, ClampCannotCreateEnergy) {
@@ -204,19 +258,25 @@ TEST(ExitGain, HomogeneousCellsKeepTheirCalibratedGain) {
   }
 }
 
-TEST(ExitGain, AnAbsorbingCellInABrightMediumTakesItsNeighboursGain) {
-  // A painted dark spot (σt x4, σs unchanged: albedo 0.2) in marble-like medium (albedo
-  // 0.95): its own gain is far larger (it corrects light injected in that cell, which the
-  // lattice holds too shallow), but most of the light it holds diffused in from the bright
-  // neighbours; with its own gain that light would glow. It takes the smallest gain among
-  // the brighter cells up to two cells away along the axes; the neighbours keep their own.
-  MaterialGrid m = test::uniformMaterial(7, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
+// A dense, less scattering spot painted into a thin, bright medium (cells 0.2 mm): the
+// bright medium injects 1 mm deep behind a retaining boundary, the spot at the Δx / 2
+// floor, so the spot's own gain is several times larger; but most of the light it holds
+// diffused in from the bright neighbours, and with its own gain that light would glow.
+constexpr double kGainCell = 0.2;
+const glm::vec3 kBrightSigmaT(1.0f), kBrightSigmaS(0.99f);  // albedo 0.99
+const glm::vec3 kDenseSigmaT(8.0f), kDenseSigmaS(7.2f);     // albedo 0.9
+
+TEST(ExitGain, ADenseLessScatteringCellInABrightMediumTakesItsNeighboursGain) {
+  // It takes the smallest gain among the brighter cells up to two cells away along the
+  // axes; the neighbours keep their own.
+  MaterialGrid m = test::uniformMaterial(7, kBrightSigmaT, kBrightSigmaS, 0.0f, kGainCell);
   const std::size_t spot = m.frame.index(3, 3, 3);
-  m.sigmaT[spot] = glm::vec3(8.0f);
+  m.sigmaT[spot] = kDenseSigmaT;
+  m.sigmaS[spot] = kDenseSigmaS;
   const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.0);
-  const float bright = calibratedTransport(2.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
-  const float dark = calibratedTransport(8.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
-  ASSERT_GT(dark, 2.0f * bright) << "the premise: an absorbing cell's own gain is much larger";
+  const float bright = calibratedTransport(kBrightSigmaT.x, kBrightSigmaS.x, 0.0, kGainCell, 1.0).exitGain;
+  const float dense = calibratedTransport(kDenseSigmaT.x, kDenseSigmaS.x, 0.0, kGainCell, 1.0).exitGain;
+  ASSERT_GT(dense, 2.0f * bright) << "the premise: the dense cell's own gain is much larger";
   EXPECT_EQ(f.exitGain[0][spot], bright);
   EXPECT_EQ(f.exitGain[0][m.frame.index(4, 3, 3)], bright);
   EXPECT_EQ(f.exitGain[0][m.frame.index(1, 1, 1)], bright);
@@ -225,26 +285,33 @@ TEST(ExitGain, AnAbsorbingCellInABrightMediumTakesItsNeighboursGain) {
   EXPECT_EQ(seed.exitGain[0][spot], 1.0f);
 }
 
-TEST(ExitGain, ALargeAbsorbingRegionKeepsItsOwnGainInside) {
-  // The limit reaches two cells: the centre of a 3-cell-wide absorbing block takes the
+TEST(ExitGain, ALargeDenseRegionKeepsItsOwnGainInside) {
+  // The limit reaches two cells: the centre of a 3-cell-wide dense block takes the
   // bright surroundings' gain, the centre of a 7-cell-wide block (four cells from the
   // bright medium) keeps its own, so large uniformly painted regions stay calibrated.
-  MaterialGrid m = test::uniformMaterial(13, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
+  MaterialGrid m = test::uniformMaterial(13, kBrightSigmaT, kBrightSigmaS, 0.0f, kGainCell);
   for (int z = 3; z <= 9; ++z)
     for (int y = 3; y <= 9; ++y)
-      for (int x = 3; x <= 9; ++x) m.sigmaT[m.frame.index(x, y, z)] = glm::vec3(8.0f);
-  const float dark = calibratedTransport(8.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
-  const float bright = calibratedTransport(2.0f, 1.9f, 0.0, 1.0, 1.0).exitGain;
+      for (int x = 3; x <= 9; ++x) {
+        m.sigmaT[m.frame.index(x, y, z)] = kDenseSigmaT;
+        m.sigmaS[m.frame.index(x, y, z)] = kDenseSigmaS;
+      }
+  const float dense = calibratedTransport(kDenseSigmaT.x, kDenseSigmaS.x, 0.0, kGainCell, 1.0).exitGain;
+  const float bright = calibratedTransport(kBrightSigmaT.x, kBrightSigmaS.x, 0.0, kGainCell, 1.0).exitGain;
+  ASSERT_NE(dense, bright);
   StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.0);
-  EXPECT_EQ(f.exitGain[1][m.frame.index(6, 6, 6)], dark);
-  EXPECT_EQ(f.exitGain[1][m.frame.index(5, 6, 6)], dark);   // three cells from the bright medium
+  EXPECT_EQ(f.exitGain[1][m.frame.index(6, 6, 6)], dense);
+  EXPECT_EQ(f.exitGain[1][m.frame.index(5, 6, 6)], dense);   // three cells from the bright medium
   EXPECT_EQ(f.exitGain[1][m.frame.index(4, 6, 6)], bright);  // two cells
   EXPECT_EQ(f.exitGain[1][m.frame.index(4, 4, 4)], bright);  // two cells along each axis
 
-  MaterialGrid small = test::uniformMaterial(13, glm::vec3(2.0f), glm::vec3(1.9f), 0.0f, 1.0);
+  MaterialGrid small = test::uniformMaterial(13, kBrightSigmaT, kBrightSigmaS, 0.0f, kGainCell);
   for (int z = 5; z <= 7; ++z)
     for (int y = 5; y <= 7; ++y)
-      for (int x = 5; x <= 7; ++x) small.sigmaT[small.frame.index(x, y, z)] = glm::vec3(8.0f);
+      for (int x = 5; x <= 7; ++x) {
+        small.sigmaT[small.frame.index(x, y, z)] = kDenseSigmaT;
+        small.sigmaS[small.frame.index(x, y, z)] = kDenseSigmaS;
+      }
   f = computeStepFactors(small, LpvScheme::Calibrated, 1.0);
   EXPECT_EQ(f.exitGain[1][small.frame.index(6, 6, 6)], bright);
 }

@@ -108,7 +108,8 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::Injection)) {
     injected_.resize(material_.frame);
-    report.injection = injectSamples(samples_, material_, injected_);
+    report.injection = injectSamples(samples_, material_, injected_,
+                                     factors_.scheme == LpvScheme::Calibrated ? &factors_ : nullptr);
     report.times.injection = watch.lapMs();
   } else {
     report.times.markCached(Stage::Injection);

@@ -7,7 +7,9 @@ namespace sslpv {
 
 void StageDirty::materialChanged(const std::optional<Bounds>& region) {
   const bool wholeAlready = dirty(Stage::Resample) && !region_;
-  set({Stage::Resample, Stage::Propagation, Stage::Shading});
+  // The calibrated injection depth follows the material (1 / σt'), so injection reruns;
+  // it costs about a millisecond.
+  set({Stage::Resample, Stage::Injection, Stage::Propagation, Stage::Shading});
   if (wholeAlready || !region) {
     region_.reset();
     return;
@@ -27,9 +29,9 @@ void StageDirty::settingsChanged(const LpvSettings& before, const LpvSettings& a
     return;
   }
   if (before.shadowMap != after.shadowMap) lightsChanged();
-  // The step factors are derived with the material, so a new scheme redoes that stage.
+  // The step factors are derived with the material and the injection differs per scheme.
   if (before.scheme != after.scheme) {
-    set({Stage::Resample, Stage::Propagation, Stage::Shading});
+    set({Stage::Resample, Stage::Injection, Stage::Propagation, Stage::Shading});
     region_.reset();
   }
   if (before.steps != after.steps || before.autoSteps != after.autoSteps)

@@ -52,7 +52,8 @@ class StageDirty {
   /// The mesh or the grid frame changed: the occupancy and everything after it.
   void geometryChanged() { everything(); }
   /// The material changed inside `region` (world bounds), or everywhere when absent.
-  /// Occupancy and injection depend only on the surface, so they stay.
+  /// Occupancy and the shadow maps depend only on the surface, so they stay; injection
+  /// reruns (the calibrated scheme injects at a material-dependent depth).
   void materialChanged(const std::optional<Bounds>& region);
   /// A light moved, changed or was added: shadow maps onwards.
   void lightsChanged() { set({Stage::ShadowMap, Stage::Injection, Stage::Propagation, Stage::Shading}); }

@@ -1,17 +1,19 @@
 // Calibrated SSLPV transport; the model and its reasons are in lpv_calibration.h.
 //
 // Derivation of the lattice's shaded reflectance R_lpv (semi-infinite layer stack n = 1,
-// 2, ..., light injected into layer 1 as a cosine lobe pointing inward, layer 0 outside):
-//  - step 1 sends the fractions (f_up, f_lat, f_down) of the lobe's power out, into layer
-//    1 and into layer 2, each then multiplied by s;
-//  - from then on cells are isotropic and every step moves 1/6 up, 1/6 down, 4/6 within
-//    the layer, times s. The power w(n) accumulated in layer n over all later steps
-//    solves  a w(n) - b (w(n-1) + w(n+1)) = q(n), a = 1 - 4s/6, b = s/6, w(0) = 0,
-//    whose Green's function (method of images) is
-//      G(n, m) = (r^|n-m| - r^(n+m)) / (b (1/r - r)),  r + 1/r = a/b = 6/s - 4;
-//    with q(1) = s f_lat, q(2) = s f_down this gives w(1) = 6 r (f_lat + r f_down).
-//  - the injected lobe itself integrates to zero over the outward hemisphere, and the
-//    shading turns an isotropic cell of power P into radiance P / (2 π Δx²); with
+// 2, ..., layer 0 outside; light injected isotropically, split between layers m and m + 1
+// with weights 1 - f and f):
+//  - every step moves 1/6 of a cell's power up, 1/6 down and 4/6 within the layer, times
+//    s; of what layer 1 sends up, the boundary returns the share ρ into layer 1. The
+//    power w(n) accumulated in layer n (the injected light included) solves
+//      a w(n) - b (w(n-1) + w(n+1)) = q(n),  a = 1 - 4s/6,  b = s/6,  w(0) = ρ w(1),
+//    with q the injected power. Its solutions are r^n and r^-n, r + 1/r = a/b = 6/s - 4;
+//    u(n) = r^-n + β r^n, β = (ρ/r - 1) / (1 - ρ r), meets the boundary condition and
+//    r^n decays, and their discrete Wronskian is b (1/r - r), so
+//      G(1, m) = u(1) r^m / (b (1/r - r)) = 6 r^m / (s (1 - ρ r))
+//    (u(1) = (1/r - r) / (1 - ρ r)), finite also at r -> 1. So
+//      w(1) = 6 ((1 - f) r^m + f r^(m+1)) / (s (1 - ρ r)).
+//  - the shading turns an isotropic cell of power P into radiance P / (2 π Δx²); with
 //    irradiance E the injected power per cell is E Δx², so π L / E = w(1) / 2.
 //  - with a boundary of relative index η the injection has already multiplied E by
 //    1 - F(0) and the shading multiplies the radiance by (1 - F(θ)) / η², so the power the
@@ -32,8 +34,6 @@
 
 #include "volume/adding_doubling.h"
 #include "volume/fresnel.h"
-#include "volume/lpv_constants.h"
-#include "volume/lpv_stages.h"
 
 namespace sslpv {
 namespace {
@@ -48,6 +48,7 @@ struct BoundaryTable {
   std::vector<double> rdOverAlbedo;
   double entering = 1.0;  ///< 1 - F(0): the injection's share of normal irradiance
   double leaving = 1.0;   ///< diffuseBoundaryTransmittance(ior): the shading's exit share
+  double extrapolation = 2.0 / 3.0;  ///< z_b σt' = 2 A / 3 (diffusionBoundaryCoefficient)
 };
 
 std::unique_ptr<const BoundaryTable> buildBoundaryTable(double ior) {
@@ -65,6 +66,7 @@ std::unique_ptr<const BoundaryTable> buildBoundaryTable(double ior) {
   }
   table->entering = 1.0 - fresnelReflectance(1.0, ior);
   table->leaving = diffuseBoundaryTransmittance(ior);
+  table->extrapolation = 2.0 * diffusionBoundaryCoefficient(ior) / 3.0;
   return table;
 }
 
@@ -83,7 +85,53 @@ const BoundaryTable& boundaryTable(double ior) {
   return *last;
 }
 
+/// Cubic interpolation through the 4 nearest of table[0..intervals] at t in [0, 1].
+double interpolateCubic(const std::vector<double>& table, double t) {
+  const int intervals = int(table.size()) - 1;
+  t *= intervals;
+  const int first = std::clamp(int(t) - 1, 0, intervals - 3);
+  const double x = t - first;
+  const double weights[4] = {-(x - 1.0) * (x - 2.0) * (x - 3.0) / 6.0, x * (x - 2.0) * (x - 3.0) / 2.0,
+                             -x * (x - 1.0) * (x - 3.0) / 2.0, x * (x - 1.0) * (x - 2.0) / 6.0};
+  double value = 0.0;
+  for (int k = 0; k < 4; ++k) value += weights[k] * table[std::size_t(first + k)];
+  return value;
+}
+
+/// The root of albedo · atanh(k) / k = 1 by bisection (the left side grows with k).
+double solveAsymptoticDecay(double albedo) {
+  if (albedo >= 1.0) return 0.0;
+  if (albedo <= 0.0) return 1.0;
+  double low = 0.0, high = 1.0;
+  for (int i = 0; i < 200 && high - low > 1e-15; ++i) {
+    const double k = 0.5 * (low + high);
+    (albedo * std::atanh(k) / k > 1.0 ? high : low) = k;
+  }
+  return 0.5 * (low + high);
+}
+
 }  // namespace
+
+double asymptoticDecay(double albedo) {
+  // Over t = sqrt(1 - albedo) the root is smooth (k ≈ sqrt(3) t near albedo 1, -> 1 as
+  // albedo -> 0), as the reflectance table's Rd / albedo is.
+  static const std::vector<double> table = [] {
+    std::vector<double> values(kReflectanceTable + 1);
+    for (int i = 0; i <= kReflectanceTable; ++i) {
+      const double t = double(i) / kReflectanceTable;
+      values[std::size_t(i)] = solveAsymptoticDecay(1.0 - t * t);
+    }
+    return values;
+  }();
+  albedo = std::clamp(albedo, 0.0, 1.0);
+  return std::clamp(interpolateCubic(table, std::sqrt(1.0 - albedo)), 0.0, 1.0);
+}
+
+double boundaryRetention(double extrapolationLength, double cellSize) {
+  const double k = 2.0 * extrapolationLength / cellSize;
+  if (!(k > 1.0)) return 0.0;
+  return std::min(kMaxRetention, (k - 1.0) / (k + 1.0));
+}
 
 bool parseLpvScheme(std::string_view name, LpvScheme& scheme) {
   if (name == "seed") {
@@ -102,28 +150,12 @@ std::string lpvSchemeName(LpvScheme scheme) { return scheme == LpvScheme::Seed ?
 double boundaryReflectance(double albedo, double ior) {
   const std::vector<double>& table = boundaryTable(ior).rdOverAlbedo;
   albedo = std::clamp(albedo, 0.0, 1.0);
-  // Cubic through the 4 nearest nodes: linear interpolation would be off by up to 4e-4
-  // relative near albedo 1 at η = 1.5, where Rd / albedo bends fastest in t.
-  const double t = std::sqrt(1.0 - albedo) * kReflectanceTable;
-  const int first = std::clamp(int(t) - 1, 0, kReflectanceTable - 3);
-  const double x = t - first;
-  const double weights[4] = {-(x - 1.0) * (x - 2.0) * (x - 3.0) / 6.0, x * (x - 2.0) * (x - 3.0) / 2.0,
-                             -x * (x - 1.0) * (x - 3.0) / 2.0, x * (x - 1.0) * (x - 2.0) / 6.0};
-  double value = 0.0;
-  for (int k = 0; k < 4; ++k) value += weights[k] * table[std::size_t(first + k)];
-  return albedo * value;
+  // Cubic: linear interpolation would be off by up to 4e-4 relative near albedo 1 at
+  // η = 1.5, where Rd / albedo bends fastest in t.
+  return albedo * interpolateCubic(table, std::sqrt(1.0 - albedo));
 }
 
 double halfSpaceReflectance(double albedo) { return boundaryReflectance(albedo, 1.0); }
-
-std::array<double, 3> injectedLobeSplit() {
-  // A lobe pointing into the medium along -z; its neighbours in the order -x,+x,-y,+y,-z,+z.
-  const std::array<float, 6> flux = neighbourFaceFlux(float(SSLPV_COSINE_LOBE_C0), 0.0f, 0.0f,
-                                                      -float(SSLPV_COSINE_LOBE_C1));
-  double total = 0.0;
-  for (float f : flux) total += f;
-  return {flux[5] / total, (flux[0] + flux[1] + flux[2] + flux[3]) / total, flux[4] / total};
-}
 
 CellTransport seedTransport(double sigmaT, double sigmaS, double g, double cellSize) {
   const double e = std::exp(-sigmaT * cellSize);
@@ -134,25 +166,39 @@ CellTransport seedTransport(double sigmaT, double sigmaS, double g, double cellS
 }
 
 CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double cellSize, double ior) {
-  static const std::array<double, 3> split = injectedLobeSplit();
   const double sigmaA = std::max(0.0, sigmaT - sigmaS);
   const double reducedS = std::max(0.0, sigmaS) * (1.0 - g);
   const double reducedT = sigmaA + reducedS;
-  const double sigmaTr = std::sqrt(3.0 * sigmaA * reducedT);
-  const double kappa = sigmaTr * cellSize;
+  const double reducedAlbedo = reducedT > 0.0 ? reducedS / reducedT : 1.0;
+  const double kappa = asymptoticDecay(reducedAlbedo) * reducedT * cellSize;
   // cosh overflows far beyond any useful κ; such a cell absorbs everything in one step.
   const double survival = kappa < 700.0 ? 3.0 / (2.0 + std::cosh(kappa)) : 0.0;
   const double r = std::exp(-kappa);
-  const double latticeReflectance = 3.0 * r * (split[1] + r * split[2]);
-  const double reducedAlbedo = reducedT > 0.0 ? reducedS / reducedT : 1.0;
+  const BoundaryTable& boundary = boundaryTable(ior);
+  // An empty cell (σt' = 0) has infinite z0 and z_b: it keeps what it is sent and the
+  // injection stays at its floor.
+  const double retention =
+      reducedT > 0.0 ? boundaryRetention(boundary.extrapolation / reducedT, cellSize) : kMaxRetention;
+  const double injectionDepth = reducedT > 0.0 ? 1.0 / reducedT : 0.0;
+  const double layer = std::max(injectionDepth, 0.5 * cellSize) / cellSize + 0.5;
+  const double first = std::floor(layer), deeper = layer - first;
+  const double latticeReflectance = survival > 0.0 ? 3.0 * std::pow(r, first) * (1.0 - deeper + deeper * r) /
+                                                         (survival * (1.0 - retention * r))
+                                                   : 0.0;
   // The injection has already taken 1 - F(0) of the irradiance and the shading lets out
   // `leaving` of an isotropic cell's power, so this gain makes the lattice reflect the
   // medium's Rd in total.
-  const BoundaryTable& boundary = boundaryTable(ior);
   const double target = boundaryReflectance(reducedAlbedo, ior) / (boundary.entering * boundary.leaving);
   double gain = latticeReflectance > 0.0 ? target / latticeReflectance : 0.0;
   if (!std::isfinite(gain) || reducedAlbedo <= 0.0) gain = 0.0;
-  return {float(survival), 0.0f, float(gain), float(reducedAlbedo)};
+  CellTransport t;
+  t.dc = float(survival);
+  t.linear = 0.0f;
+  t.exitGain = float(gain);
+  t.reducedAlbedo = float(reducedAlbedo);
+  t.retention = float(retention);
+  t.injectionDepth = float(injectionDepth);
+  return t;
 }
 
 void prepareCalibrationTables(double ior) {

@@ -12,33 +12,48 @@
 //     which makes propagation an exact lattice random walk: from a laterally uniform
 //     layer, 1/6 of a step's power moves up, 1/6 down and 4/6 stays in the layer.
 //  2. Picks the DC survival s per step so that the walk decays with depth exactly as
-//     diffusion in the medium does, exp(-σtr z), σtr = sqrt(3 σa σt') with the reduced
-//     σt' = σa + σs(1 - g): the walk's steady state decays as r^n per layer with
-//     r + 1/r = 6/s - 4, so s = 3 / (2 + cosh(σtr Δx)). This holds for any cell size
-//     relative to the mean free path; g enters through σt' (similarity relation).
-//  3. Scales the exitant radiance by a coupling gain G: the walk has the right diffusion
-//     length but couples to the boundary over a cell instead of over a transport mean
-//     free path. For a semi-infinite layer under normal illumination the lattice's shaded
-//     reflectance is, in closed form (derivation in lpv_calibration.cpp),
-//        R_lpv = 3 r (f_lat + r f_down),  r = exp(-σtr Δx),
-//     where f_lat and f_down are the fractions of an injected cosine lobe that the first
-//     step keeps in its layer and sends one layer deeper. G makes the power the lattice
-//     reflects equal the medium's total diffuse reflectance Rd(α', η) under collimated
-//     normal incidence: exact transport in an isotropically scattering half-space (reduced
-//     albedo α', similarity relation) behind a smooth boundary of relative index η, from
-//     the adding-doubling method (adding_doubling.h). At η = 1 that is
-//     1 - H(1; α')·sqrt(1 - α') (Chandrasekhar's H-function). With a boundary, the
-//     injection's entry transmittance 1 - F(0) and the shading's exit transmittance of an
-//     isotropic cell (diffuseBoundaryTransmittance) are divided out:
+//     transport in the medium does far from sources and boundaries, exp(-κ z): κ is the
+//     asymptotic decay constant of radiative transport, α' atanh(κ/σt') / (κ/σt') = 1
+//     for the reduced albedo α' = σs' / σt', σs' = σs(1 - g), σt' = σa + σs' (similarity
+//     relation). Diffusion's σtr = sqrt(3 σa σt') is its α' -> 1 limit; at α' = 0.8 it
+//     is 9 % too large, which over a 4 mean-free-path slab darkens transmission by 25 %.
+//     The walk's steady state decays as r^n per layer with r + 1/r = 6/s - 4, so
+//     s = 3 / (2 + cosh(κ Δx)). This holds for any cell size relative to the mean free
+//     path.
+//  3. Gives the lattice the medium's boundary, so that light crossing a thin object
+//     comes out as it should at every grid resolution, not only light reflected near
+//     where it entered. A diffuse field meets a boundary as if it vanished an
+//     extrapolation length z_b = 2 A / (3 σt') outside it (A from the Fresnel moments,
+//     diffusionBoundaryCoefficient), and light entering as a beam starts diffusing about
+//     z0 = 1 / σt' deep. The bare lattice has z_b = Δx / 2 (light sent to an outside cell
+//     is lost) and injects Δx / 2 deep; both shrink with the cells, so thin slabs went
+//     darker as the grid was refined (jade: x0.88 at 32³, x0.59 at 64³). So a boundary
+//     cell returns to itself the share ρ of the light it sends toward each outside
+//     neighbour: with a linear profile that puts the zero z_b beyond the face for
+//     ρ = (k - 1) / (k + 1), k = 2 z_b / Δx (ρ = 0 when z_b < Δx / 2, at most
+//     kMaxRetention), and light is injected isotropically max(z0, Δx / 2) deep.
+//  4. Scales the exitant radiance by a coupling gain G so that a thick slab's diffuse
+//     reflectance is exact. For a semi-infinite layer stack under normal illumination
+//     the lattice's shaded reflectance is, in closed form (derivation in
+//     lpv_calibration.cpp), with the injection depth at layer m* = depth / Δx + 1/2
+//     split linearly between layers m = floor(m*) and m + 1 (fraction f):
+//        R_lpv = 3 ((1 - f) r^m + f r^(m+1)) / (s (1 - ρ r)),  r = exp(-κ Δx).
+//     G makes the power the lattice reflects equal the medium's total diffuse reflectance
+//     Rd(α', η) under collimated normal incidence: exact transport in an isotropically
+//     scattering half-space (reduced albedo α', similarity relation) behind a smooth
+//     boundary of relative index η, from the adding-doubling method (adding_doubling.h).
+//     At η = 1 that is 1 - H(1; α')·sqrt(1 - α') (Chandrasekhar's H-function). With a
+//     boundary, the injection's entry transmittance 1 - F(0) and the shading's exit
+//     transmittance of an isotropic cell (diffuseBoundaryTransmittance) are divided out:
 //        G = Rd(α', η) / ((1 - F(0)) · T_exit(η) · R_lpv).
 //     So the reflected power is exact for a thick slab.
-//  4. Gives that power the medium's angular distribution instead of the lattice's
-//     (Lambertian inside, Fresnel-weighted outside): the shading weights each cell's
-//     exitant radiance by the half-space's exit shape for its α' and η, normalised to
-//     the same total power (volume/exit_law.h).
 //     (The η-dependence used to come from the dipole's ratio Rd(α', η) / Rd(α', 1): at
 //     η = 1.3 it put the reflected power per entering power 1 % low at α' ≈ 1 and up to
 //     85 % high at α' = 0.02, Jensen's ketchup blue.)
+//  5. Gives that power the medium's angular distribution instead of the lattice's
+//     (Lambertian inside, Fresnel-weighted outside): the shading weights each cell's
+//     exitant radiance by the half-space's exit shape for its α' and η, normalised to
+//     the same total power (volume/exit_law.h).
 //
 // Keeping the seed scheme selectable lets the benchmark show both.
 #include <array>
@@ -61,13 +76,33 @@ struct CellTransport {
   /// α' = σs(1-g) / (σa + σs(1-g)): picks the cell's exit angular shape (exit_law.h;
   /// calibrated scheme only).
   float reducedAlbedo = 1.0f;
+  /// ρ: share of the light sent toward an outside neighbour that a boundary cell of this
+  /// material keeps (calibrated scheme; 0 in the seed's).
+  float retention = 0.0f;
+  /// Depth below the surface at which light entering this material is injected, in
+  /// scene units, before the Δx / 2 floor (calibrated scheme: 1 / σt'; 0 in the seed's,
+  /// whose lobes go half a cell deep).
+  float injectionDepth = 0.0f;
 };
+
+/// Upper bound of ρ. Where z_b spans many cells (optically thin cells) diffusion does not
+/// describe the object anyway, and ρ -> 1 would hold light for thousands of steps.
+inline constexpr double kMaxRetention = 0.95;
 
 /// The seed's factors (e = exp(-σt Δx), α = σs/σt: dc = e + α(1-e), linear = e + α(1-e)g).
 CellTransport seedTransport(double sigmaT, double sigmaS, double g, double cellSize);
 
 /// The calibrated factors for a cell of the given material, cell size and boundary index.
 CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double cellSize, double ior);
+
+/// κ / σt' of radiative transport with isotropic scattering at albedo `albedo` (use α'):
+/// the root in (0, 1] of albedo · atanh(k) / k = 1 (1 at albedo 0, 0 at albedo 1).
+/// Tabulated once over sqrt(1 - albedo) (129 nodes, cubic; within 1e-6 of the root).
+double asymptoticDecay(double albedo);
+
+/// The lattice boundary retention ρ = (k - 1) / (k + 1), k = 2 z_b / Δx, clamped to
+/// [0, kMaxRetention], for an extrapolation length z_b and cell size Δx.
+double boundaryRetention(double extrapolationLength, double cellSize);
 
 /// Total diffuse reflectance of a semi-infinite isotropically scattering medium of the
 /// given albedo with a smooth boundary of relative index `ior`, under a collimated beam at
@@ -88,9 +123,5 @@ void prepareCalibrationTables(double ior);
 /// exactIsotropicRd (volume/slab_reflectance.h) computes it from the H-function.
 double halfSpaceReflectance(double albedo);
 
-/// Fractions of an injected cosine lobe's power that the first propagation step sends
-/// (back out of the layer, within the layer, one layer deeper), from the same clamped
-/// face evaluation the propagation uses.
-std::array<double, 3> injectedLobeSplit();
 
 }  // namespace sslpv

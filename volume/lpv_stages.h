@@ -47,15 +47,24 @@ std::vector<SurfaceFluxSample> castShadowMap(const Light& light, const RayScene&
 int activeTrilinearWeights(const MaterialGrid& material, const glm::dvec3& p,
                            std::size_t cells[8], float weights[8]);
 
+struct StepFactors;
+
 struct InjectionStats {
   glm::dvec3 injectedFlux{0.0};  ///< total flux written into the grid
   glm::dvec3 droppedFlux{0.0};   ///< flux of samples with no active cell nearby
 };
 
-/// Adds each sample as a clamped cosine lobe about its refracted direction, holding
-/// flux/π, half a cell inside the surface, spread trilinearly over active cells.
+/// Seed scheme (`calibrated` null): adds each sample as a clamped cosine lobe about its
+/// refracted direction, holding flux/π, half a cell inside the surface, spread
+/// trilinearly over active cells. Calibrated scheme (`calibrated` holds its step factors):
+/// per channel, an isotropic source of the sample's flux at depth
+/// max(injectionDepth cos θt, Δx / 2) along the inward normal, injectionDepth read from
+/// the cell half a cell inside (lpv_calibration.h), θt the refracted direction's angle to
+/// the normal. Either way a sample that finds no active cell
+/// there looks a cell deeper (Δx / 2 further) before it is dropped.
 InjectionStats injectSamples(const std::vector<SurfaceFluxSample>& samples,
-                             const MaterialGrid& material, ShGrid& grid);
+                             const MaterialGrid& material, ShGrid& grid,
+                             const StepFactors* calibrated = nullptr);
 
 /// Per-step power bookkeeping. Every quantity is total flux (W), per channel.
 struct StepEnergy {
@@ -94,6 +103,14 @@ struct StepFactors {
   /// cell's exit angular shape in shading (volume/exit_law.h). Empty in the seed scheme,
   /// whose exit stays Lambertian inside the boundary.
   std::array<std::vector<float>, 3> reducedAlbedo;
+  /// Calibrated scheme: per channel, per cell, ρ times the number of the cell's six
+  /// neighbours that are outside the object: each step a boundary cell keeps that many
+  /// times ρ of what it sends one neighbour (isotropic cells send each neighbour 1/6).
+  /// Empty in the seed scheme, whose boundary loses everything sent across it.
+  std::array<std::vector<float>, 3> retention;
+  /// Calibrated scheme: per channel, per cell, CellTransport::injectionDepth (scene
+  /// units). Empty in the seed scheme.
+  std::array<std::vector<float>, 3> injectionDepth;
   std::vector<unsigned char> active;  ///< coverage > 0 and not on the outer ring
   /// Per (y, z) row: does it hold any active cell? Rows without one never hold light and
   /// are skipped, so cost follows the object's cells rather than its bounding box.

@@ -141,6 +141,8 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
       const float* __restrict dc = factors.dc[ch].data();
       const float* __restrict lin = factors.linear[ch].data();
       const unsigned char* __restrict active = factors.active.data();
+      // Seed scheme: no retention (a zero row stands in).
+      const float* __restrict retain = factors.retention[ch].empty() ? nullptr : factors.retention[ch].data();
       float* __restrict out[4] = {dst.plane(ch, 0), dst.plane(ch, 1), dst.plane(ch, 2), dst.plane(ch, 3)};
       float* __restrict sum[4] = {accumulated.plane(ch, 0), accumulated.plane(ch, 1), accumulated.plane(ch, 2),
                                   accumulated.plane(ch, 3)};
@@ -156,6 +158,9 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
         gatherFrom<2, +1>(c0, cx, cy, cz, i - sz, g);
         gatherFrom<2, -1>(c0, cx, cy, cz, i + sz, g);
         const float on = active[i] ? 1.0f : 0.0f;
+        // The boundary's share of what this cell sent toward outside neighbours: the DC an
+        // isotropic cell sends one neighbour, times ρ per outside neighbour.
+        if (retain != nullptr) g.c0 += retain[i] * (kEmitDC * (kFront + 4.0f * kSide) * sh::kY00) * c0[i];
         const float v0 = on * g.c0 * dc[i];
         const float v1 = on * g.c[0] * lin[i], v2 = on * g.c[1] * lin[i], v3 = on * g.c[2] * lin[i];
         out[0][i] = v0;
@@ -188,16 +193,18 @@ glm::dvec3 gridPower(const ShGrid& grid) {
 }
 
 // The calibrated exit gain maps a homogeneous medium's lattice reflectance to the true
-// one; it grows like 1/r (r = exp(-σtr Δx)) as a cell gets more absorbing, because there
-// the lattice's first cell holds far less light than the medium's first transport length.
-// That holds for light injected in the cell itself. A strongly absorbing spot painted into
-// a bright medium also receives light diffusing in from its brighter surroundings, and its
-// large gain would turn that into a glow where the artist painted a dark spot. So a cell
-// uses the smallest gain among itself and the cells up to kExitGainReach cells away along
-// the axes whose reduced albedo (this channel) is at least its own: the media its light
-// can have come from in quantity. Inside a homogeneous region nothing changes (all gains
-// equal); a brighter cell never takes a darker neighbour's gain (no fringes between
-// painted media).
+// one. It is calibrated for light injected in the cell's own material: it is larger where
+// that light sits near the surface cell with little retention (dense cells, injected at
+// the Δx / 2 floor) than where it is injected deep behind a retaining boundary (thin
+// bright media at fine cells). A dense spot painted into a thin bright medium also
+// receives light diffusing in from its surroundings, and its larger gain would turn that
+// into a glow. So a cell uses the smallest gain among itself and the cells up to
+// kExitGainReach cells away along the axes whose reduced albedo (this channel) is at
+// least its own: the media its light can have come from in quantity. Inside a
+// homogeneous region nothing changes (all gains equal); a brighter cell never takes a
+// darker neighbour's gain (no fringes between painted media). (With the seed-style
+// cosine-lobe injection any absorbing spot had this problem; with the isotropic
+// injection at depth an absorbing spot's own gain is the smaller one.)
 constexpr int kExitGainReach = 2;
 
 void limitExitGainToNeighbours(const MaterialGrid& material, StepFactors& factors) {
@@ -232,6 +239,26 @@ void limitExitGainToNeighbours(const MaterialGrid& material, StepFactors& factor
   }
 }
 
+/// Turns each active cell's ρ into ρ times its number of outside (inactive) neighbours.
+void countOutsideNeighbours(const GridFrame& f, StepFactors& factors) {
+  tbb::parallel_for(0, f.dims.z, [&](int z) {
+    for (int y = 0; y < f.dims.y; ++y)
+      for (int x = 0; x < f.dims.x; ++x) {
+        const std::size_t i = f.index(x, y, z);
+        if (!factors.active[i]) continue;
+        int outside = 0;
+        for (int axis = 0; axis < 3; ++axis)
+          for (int d = -1; d <= 1; d += 2) {
+            glm::ivec3 other(x, y, z);
+            other[axis] += d;
+            // Active cells never touch the grid's edge (the outer ring is inactive).
+            if (!factors.active[f.index(other.x, other.y, other.z)]) ++outside;
+          }
+        for (int ch = 0; ch < 3; ++ch) factors.retention[ch][i] *= float(outside);
+      }
+  });
+}
+
 }  // namespace
 
 StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, double ior) {
@@ -243,7 +270,11 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
     factors.dc[ch].assign(n, 0.0f);
     factors.linear[ch].assign(n, 0.0f);
     factors.exitGain[ch].assign(n, 1.0f);
-    if (scheme == LpvScheme::Calibrated) factors.reducedAlbedo[ch].assign(n, 0.0f);
+    if (scheme == LpvScheme::Calibrated) {
+      factors.reducedAlbedo[ch].assign(n, 0.0f);
+      factors.retention[ch].assign(n, 0.0f);
+      factors.injectionDepth[ch].assign(n, 0.0f);
+    }
   }
   factors.active.assign(n, 0);
   factors.rowActive.assign(std::size_t(f.dims.y) * f.dims.z, 0);
@@ -263,11 +294,18 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
           factors.dc[ch][i] = t.dc;
           factors.linear[ch][i] = t.linear;
           factors.exitGain[ch][i] = t.exitGain;
-          if (scheme == LpvScheme::Calibrated) factors.reducedAlbedo[ch][i] = t.reducedAlbedo;
+          if (scheme == LpvScheme::Calibrated) {
+            factors.reducedAlbedo[ch][i] = t.reducedAlbedo;
+            factors.retention[ch][i] = t.retention;  // times the outside neighbours below
+            factors.injectionDepth[ch][i] = t.injectionDepth;
+          }
         }
       }
   });
-  if (scheme == LpvScheme::Calibrated) limitExitGainToNeighbours(material, factors);
+  if (scheme == LpvScheme::Calibrated) {
+    countOutsideNeighbours(f, factors);
+    limitExitGainToNeighbours(material, factors);
+  }
   return factors;
 }
 
