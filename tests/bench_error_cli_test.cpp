@@ -4,12 +4,9 @@
 // file alone), a corrupt cache file is re-rendered, bad input exits 2 with one line and
 // no output, and a missing plot exits 3 after writing the tables. The plot itself is
 // checked by running sslpv-plot on a hand-made table (under xvfb-run without DISPLAY).
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -24,8 +21,6 @@
 
 #include "test_support.h"
 #include "volume/image_io.h"
-
-extern char** environ;
 
 namespace sslpv::test {
 namespace {
@@ -295,25 +290,6 @@ TEST_F(BenchErrorCli, WithoutAVulkanDeviceTheVulkanConfigurationsAreSkippedLoudl
       << only.stderrText;
 }
 
-/// Runs `args` (argv[0] an absolute path) with output into `log`; the exit code or -signal.
-int run(const std::vector<std::string>& args, const fs::path& log) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  std::vector<std::string> storage = args;
-  std::vector<char*> argv;
-  for (std::string& a : storage) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int rc = ::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) return -1000;
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-}
-
 TEST(BenchErrorPlot, DrawsEveryScenesPointsInItsColour) {
   const std::string why = plotUnavailable();
   if (!why.empty()) GTEST_SKIP() << "plot not testable here: " << why;
@@ -332,8 +308,8 @@ TEST(BenchErrorPlot, DrawsEveryScenesPointsInItsColour) {
   if (!haveDisplay()) args = {findInPath("xvfb-run")->string(), "-a", "-s", "-screen 0 1280x1024x24"};
   args.insert(args.end(), {SSLPV_PLOT_BINARY, (dir / "in.json").string(), (dir / "plot.png").string(), "--size",
                            "640x480"});
-  const int code = run(args, dir / "log");
-  ASSERT_EQ(code, 0) << readText(dir / "log");
+  const RunResult plot = runProgram(args);
+  ASSERT_EQ(plot.exitCode, 0) << plot.stdoutText << plot.stderrText;
   const Image png = readImage(dir / "plot.png");
   ASSERT_EQ(png.width, 640);
   ASSERT_EQ(png.height, 480);
@@ -352,7 +328,7 @@ TEST(BenchErrorPlot, DrawsEveryScenesPointsInItsColour) {
   EXPECT_GT(orange, 100) << "scene b/ketchup's points and front";
   std::set<std::string> left;
   for (const auto& e : fs::directory_iterator(dir.path())) left.insert(e.path().filename().string());
-  EXPECT_EQ(left, (std::set<std::string>{"in.json", "log", "plot.png"})) << "no temporary file left";
+  EXPECT_EQ(left, (std::set<std::string>{"in.json", "plot.png"})) << "no temporary file left";
 #endif
 }
 
@@ -363,9 +339,9 @@ TEST(BenchErrorPlot, RejectsATableWithoutRows) {
   TempDir dir;
   writeText(dir / "in.json", R"({"spp": 1, "block": 1, "repeats": 1, "rows": []})");
   // Bad input is found before any X connection, so no display is needed.
-  const int code = run({SSLPV_PLOT_BINARY, (dir / "in.json").string(), (dir / "plot.png").string()}, dir / "log");
-  EXPECT_EQ(code, 2) << readText(dir / "log");
-  EXPECT_NE(readText(dir / "log").find("no row"), std::string::npos) << readText(dir / "log");
+  const RunResult plot = runProgram({SSLPV_PLOT_BINARY, (dir / "in.json").string(), (dir / "plot.png").string()});
+  EXPECT_EQ(plot.exitCode, 2) << plot.stderrText;
+  EXPECT_NE(plot.stderrText.find("no row"), std::string::npos) << plot.stderrText;
   EXPECT_FALSE(fs::exists(dir / "plot.png"));
 #endif
 }
