@@ -124,6 +124,9 @@ inline void gatherFrom(const float* __restrict c0, const float* __restrict cx, c
 /// One gather into dst for the interior rows of slice z; applies the step factors,
 /// accumulates, and records the slice's power sums. All six neighbours are read in one
 /// pass over the row so each output is written once.
+/// kRetain: the calibrated scheme's boundary retention (a template parameter so that the
+/// seed scheme's loop carries no test in its body).
+template <bool kRetain>
 void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& dst, ShGrid& accumulated,
                  SliceSums& s) {
   const GridFrame& f = src.frame;
@@ -141,8 +144,7 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
       const float* __restrict dc = factors.dc[ch].data();
       const float* __restrict lin = factors.linear[ch].data();
       const unsigned char* __restrict active = factors.active.data();
-      // Seed scheme: no retention (a zero row stands in).
-      const float* __restrict retain = factors.retention[ch].empty() ? nullptr : factors.retention[ch].data();
+      const float* __restrict retain = kRetain ? factors.retention[ch].data() : nullptr;
       float* __restrict out[4] = {dst.plane(ch, 0), dst.plane(ch, 1), dst.plane(ch, 2), dst.plane(ch, 3)};
       float* __restrict sum[4] = {accumulated.plane(ch, 0), accumulated.plane(ch, 1), accumulated.plane(ch, 2),
                                   accumulated.plane(ch, 3)};
@@ -160,7 +162,7 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
         const float on = active[i] ? 1.0f : 0.0f;
         // The boundary's share of what this cell sent toward outside neighbours: the DC an
         // isotropic cell sends one neighbour, times ρ per outside neighbour.
-        if (retain != nullptr) g.c0 += retain[i] * (kEmitDC * (kFront + 4.0f * kSide) * sh::kY00) * c0[i];
+        if constexpr (kRetain) g.c0 += retain[i] * (kEmitDC * (kFront + 4.0f * kSide) * sh::kY00) * c0[i];
         const float v0 = on * g.c0 * dc[i];
         const float v1 = on * g.c[0] * lin[i], v2 = on * g.c[1] * lin[i], v3 = on * g.c[2] * lin[i];
         out[0][i] = v0;
@@ -344,12 +346,18 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
   ShGrid next;
   next.resize(f);
   std::vector<SliceSums> sums(f.dims.z);
+  const bool retain = !factors.retention[0].empty();
   for (int step = 0; step < maxSteps; ++step) {
     std::fill(sums.begin(), sums.end(), SliceSums{});
     normalizeEmission(factors, field, sums);
     tbb::parallel_for(tbb::blocked_range<int>(1, f.dims.z - 1), [&](const tbb::blocked_range<int>& zs) {
       FlushDenormals flush;
-      for (int z = zs.begin(); z < zs.end(); ++z) gatherSlice(z, factors, field, next, accumulated, sums[z]);
+      for (int z = zs.begin(); z < zs.end(); ++z) {
+        if (retain)
+          gatherSlice<true>(z, factors, field, next, accumulated, sums[z]);
+        else
+          gatherSlice<false>(z, factors, field, next, accumulated, sums[z]);
+      }
     });
     std::swap(field.planes, next.planes);
     ++result.stepsRun;
