@@ -112,8 +112,12 @@ std::string cacheProblem(const fs::path& exr, const fs::path& side, const Refere
 
 Reference obtainReference(const std::string& sceneArg, const Scene& scene, const fs::path& cacheDir, int spp,
                           std::uint64_t seed) {
-  ReferenceSidecar want{sceneArg, sceneContentHash(scene), "", spp, seed, 0.0, scene.camera.width,
-                        scene.camera.height};
+  const ReferenceTracer tracer(scene);
+  // References that connect lights exactly through flat dielectric faces differ from the
+  // straight-line ones earlier versions cached under the same scene content.
+  const bool flatFaces = scene.material.ior != 1.0 && tracer.exactLightConnections();
+  ReferenceSidecar want{sceneArg, sceneContentHash(scene, flatFaces ? "exact flat-face light connections" : ""),
+                        "", spp, seed, 0.0, scene.camera.width, scene.camera.height};
   const std::string stem = referenceCacheStem(scene, want.hash, spp, seed);
   const fs::path exr = cacheDir / (stem + ".exr"), side = cacheDir / (stem + ".json");
   Reference ref;
@@ -134,7 +138,6 @@ Reference obtainReference(const std::string& sceneArg, const Scene& scene, const
   std::fprintf(stderr, "bench-error: path tracing the reference of %s (%dx%d, %d spp, seed %llu)\n",
                sceneArg.c_str(), scene.camera.width, scene.camera.height, spp,
                static_cast<unsigned long long>(seed));
-  const ReferenceTracer tracer(scene);
   ReferenceOptions options;
   options.spp = spp;
   options.seed = seed;

@@ -282,7 +282,10 @@ TEST(BenchErrorCache, KeyFollowsTheContentOfTheSceneAndTheFilesItNames) {
 
   // The mesh file changes, the scene file does not: another reference too.
   writeText(dir / "tetra.obj", std::string(kTetra) + "# moved\n");
-  EXPECT_NE(sceneContentHash(loadScene(dir / "scene.json")), afterSceneEdit);
+  const std::string afterMeshEdit = sceneContentHash(loadScene(dir / "scene.json"));
+  EXPECT_NE(afterMeshEdit, afterSceneEdit);
+  // The tracer's light-connection mode is part of the key when it is given.
+  EXPECT_NE(sceneContentHash(loadScene(dir / "scene.json"), "exact flat-face light connections"), afterMeshEdit);
 }
 
 TEST(BenchErrorCache, FileHashSeesEveryByte) {

@@ -257,7 +257,7 @@ std::string benchJson(const BenchRunInfo& info, const std::vector<BenchRow>& row
   return record.dump(2) + "\n";
 }
 
-std::string sceneContentHash(const Scene& scene) {
+std::string sceneContentHash(const Scene& scene, const std::string& salt) {
   std::uint64_t h = 0xcbf29ce484222325ull;
   // Lengths between the parts, so moving bytes from one file to the next changes the key.
   auto add = [&h](const std::string& bytes) {
@@ -267,6 +267,7 @@ std::string sceneContentHash(const Scene& scene) {
   add(readBytes(scene.file));
   if (scene.mesh.kind == MeshSource::Kind::File) add(readBytes(scene.mesh.path));
   if (scene.material.vdb) add(readBytes(*scene.material.vdb));
+  if (!salt.empty()) add(salt);
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
   return text;

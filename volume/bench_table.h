@@ -113,9 +113,10 @@ struct BenchRunInfo {
 std::string benchJson(const BenchRunInfo& info, const std::vector<BenchRow>& rows);
 
 /// FNV-1a 64 of the scene file's bytes and of the mesh and material-set files it names,
-/// as 16 hex digits: editing any of them changes the reference. InputError when a file
-/// cannot be read.
-std::string sceneContentHash(const Scene& scene);
+/// and of `salt` when not empty (what else the reference depends on, such as the
+/// tracer's light-connection mode), as 16 hex digits: editing any of them changes the
+/// reference. InputError when a file cannot be read.
+std::string sceneContentHash(const Scene& scene, const std::string& salt = "");
 
 /// FNV-1a 64 of one file's bytes as 16 hex digits (InputError when unreadable): the
 /// sidecar keeps it so that a cached image damaged in any byte is not trusted.

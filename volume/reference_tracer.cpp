@@ -15,6 +15,7 @@
 
 #include "volume/error.h"
 #include "volume/fresnel.h"
+#include "volume/refracted_connection.h"
 #include "volume/majorant_grid.h"
 #include "volume/ray_scene.h"
 #include "volume/scene_object.h"
@@ -28,6 +29,9 @@ constexpr double kPi = 3.14159265358979323846;
 /// pathological loops (total internal reflection in an empty region), never by the
 /// estimator in practice; Russian roulette ends ordinary paths long before.
 constexpr int kMaxSegments = 1 << 20;
+// A box has 6 planes; a curved mesh has about as many as triangles, and trying every face
+// at every vertex would cost more than the straight-line connection saves.
+constexpr std::size_t kMaxConnectionPlanes = 64;
 /// Scattering events before Russian roulette starts.
 constexpr int kRouletteStart = 8;
 
@@ -98,6 +102,11 @@ struct ReferenceTracer::Impl {
   double epsilon = 1e-5;
   MaterialSample base;  ///< the field outside every active voxel's reach
   std::unique_ptr<MajorantGrid> majorants;
+  /// ior != 1 and a mesh of at most kMaxConnectionPlanes planes: lights are connected
+  /// exactly through the flat faces (refractedLight) instead of along the straight line.
+  bool exactConnections = false;
+  std::vector<BoundaryPlane> planes;
+  std::vector<int> planeOfTriangle;
 
   struct LightSample {
     glm::dvec3 toLight{0.0};  ///< unit
@@ -126,6 +135,66 @@ struct ReferenceTracer::Impl {
     return s;
   }
 
+  /// Residual ratio tracking (Novák et al. 2014) along p + t*dir, t in [0, length], all
+  /// inside the medium: the brick's minorant σc attenuates analytically, only σt - σc is
+  /// tracked, with majorant σ̄ - σc. Homogeneous bricks have σc = σ̄ = σt: exact, no lookups.
+  double insideTransmittance(const MaterialField::Sampler& field, const glm::dvec3& p, const glm::dvec3& dir,
+                             double length, int c, ReferenceRng& rng) const {
+    double tr = 1.0;
+    MajorantGrid::Walker walk(*majorants, p, dir, length);
+    MajorantGrid::Segment s;
+    while (tr > 0.0 && walk.next(s)) {
+      const double control = s.brick->minorant[c];
+      const double residual = s.brick->majorant[c] - control;
+      tr *= std::exp(-control * (s.t1 - s.t0));
+      if (s.brick->homogeneous || !(residual > 0.0)) continue;
+      for (double t = s.t0;;) {
+        t -= std::log(1.0 - rng.uniform()) / residual;
+        if (t >= s.t1) break;
+        const double sigmaT = channelOf(field.sample(p + t * dir).sigmaT, c);
+        tr *= std::max(0.0, 1.0 - (sigmaT - control) / residual);
+        if (tr < 0.1) {  // Russian roulette keeps the estimator unbiased and the loop short
+          if (rng.uniform() < 0.5) return 0.0;
+          tr *= 2.0;
+        }
+      }
+    }
+    return tr;
+  }
+
+  /// In-scattered radiance at x (before β) from `light` through the flat faces of the
+  /// boundary (exact connections, refracted_connection.h): per face the refracted path, if
+  /// it leaves x through that face and reaches the light unobstructed outside.
+  double refractedLight(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
+                        const Light& light, int c, ReferenceRng& rng) const {
+    const bool directional = light.type == Light::Type::Directional;
+    const double value = channelOf(directional ? light.irradiance : light.intensity, c);
+    if (!(value > 0.0)) return 0.0;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < planes.size(); ++k) {
+      const std::optional<RefractedConnection> path =
+          directional ? connectDirectionalLight(x, glm::normalize(light.direction), planes[k], eta)
+                      : connectPointLight(x, light.position, planes[k], eta);
+      if (!path) continue;
+      if (light.type == Light::Type::Spot &&
+          glm::dot(-path->toLightOutside, glm::normalize(light.direction)) < std::cos(glm::radians(0.5 * light.fovDeg)))
+        continue;
+      // The path must leave x through this face at y: the first boundary from x is there.
+      const RayHit exit = rays->intersect(glm::vec3(x), glm::vec3(path->toLightInside), 0.0f,
+                                          float(path->insideDistance * (1.0 + 1e-4) + 10.0 * epsilon));
+      if (!exit.hit || planeOfTriangle[exit.triangle] != int(k) ||
+          std::abs(double(exit.t) - path->insideDistance) > 1e-4 * path->insideDistance + 10.0 * epsilon)
+        continue;
+      const float outsideFar = std::isfinite(path->outsideDistance) ? float(path->outsideDistance) : 3.0e38f;
+      if (rays->intersect(glm::vec3(path->surfacePoint), glm::vec3(path->toLightOutside), float(epsilon), outsideFar).hit)
+        continue;
+      const double tr = insideTransmittance(field, x, path->toLightInside, path->insideDistance, c, rng);
+      sum += hgPhase(glm::dot(d, path->toLightInside), g) * value * path->geometry *
+             (1.0 - fresnelReflectance(path->cosOutside, eta)) * tr;
+    }
+    return sum;
+  }
+
   /// Residual ratio tracking over the inside parts of origin + t*dir, t in [0, distance],
   /// brick by brick with each brick's minorant and majorant; homogeneous bricks contribute
   /// exp(-σt·length) exactly. With `fresnel`, each boundary crossing multiplies by the straight-line
@@ -142,29 +211,7 @@ struct ReferenceTracer::Impl {
       const glm::dvec3 n(hit.normal);
       const double cosN = glm::dot(dir, n);
       const double length = double(hit.t);
-      if (cosN > 0.0) {
-        MajorantGrid::Walker walk(*majorants, p, dir, length);
-        MajorantGrid::Segment s;
-        while (tr > 0.0 && walk.next(s)) {
-          // Residual ratio tracking (Novák et al. 2014): the brick's minorant σc attenuates
-          // analytically, only σt - σc is tracked, with majorant σ̄ - σc. Homogeneous bricks
-          // have σc = σ̄ = σt: exact, no lookups.
-          const double control = s.brick->minorant[c];
-          const double residual = s.brick->majorant[c] - control;
-          tr *= std::exp(-control * (s.t1 - s.t0));
-          if (s.brick->homogeneous || !(residual > 0.0)) continue;
-          for (double t = s.t0;;) {
-            t -= std::log(1.0 - rng.uniform()) / residual;
-            if (t >= s.t1) break;
-            const double sigmaT = channelOf(field.sample(p + t * dir).sigmaT, c);
-            tr *= std::max(0.0, 1.0 - (sigmaT - control) / residual);
-            if (tr < 0.1) {  // Russian roulette keeps the estimator unbiased and the loop short
-              if (rng.uniform() < 0.5) return 0.0;
-              tr *= 2.0;
-            }
-          }
-        }
-      }
+      if (cosN > 0.0) tr *= insideTransmittance(field, p, dir, length, c, rng);
       if (fresnel) tr *= 1.0 - fresnelReflectance(std::abs(cosN), eta);
       p += length * dir;
       remaining -= length;
@@ -211,6 +258,10 @@ struct ReferenceTracer::Impl {
             if (!s.brick->homogeneous && rng.uniform() * sigmaBar >= sigmaT) continue;  // null collision
             beta *= channelOf(m.sigmaS, c) / sigmaT;
             for (const Light& light : scene.lights) {
+              if (exactConnections) {
+                radiance += beta * refractedLight(field, x, d, double(m.g), light, c, rng);
+                continue;
+              }
               const LightSample ls = sampleLight(light, x, c);
               if (ls.value <= 0.0) continue;
               const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true, true);
@@ -287,6 +338,14 @@ ReferenceTracer::ReferenceTracer(const Scene& scene, std::shared_ptr<const Mater
   majorant_ = impl_->majorants->globalMajorant();
   impl_->rays = std::make_unique<RayScene>(impl_->object->mesh());
   impl_->eta = scene.material.ior;
+  if (impl_->eta != 1.0) {
+    std::optional<std::vector<BoundaryPlane>> planes =
+        meshPlanes(impl_->object->mesh(), kMaxConnectionPlanes, &impl_->planeOfTriangle);
+    if (planes) {
+      impl_->planes = std::move(*planes);
+      impl_->exactConnections = true;
+    }
+  }
   const Bounds& b = impl_->object->bounds();
   const double extent = std::max({b.max.x - b.min.x, b.max.y - b.min.y, b.max.z - b.min.z, 1e-6});
   // Well above float round-off of Embree's hit distances, well below any feature size.
@@ -302,6 +361,8 @@ double ReferenceTracer::radianceSample(const glm::dvec3& origin, const glm::dvec
 }
 
 const MajorantGrid& ReferenceTracer::majorantGrid() const { return *impl_->majorants; }
+
+bool ReferenceTracer::exactLightConnections() const { return impl_->eta == 1.0 || impl_->exactConnections; }
 
 const MaterialField& ReferenceTracer::field() const { return impl_->object->field(); }
 

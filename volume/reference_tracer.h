@@ -8,17 +8,24 @@
 // (ior 1 = invisible boundary) and next-event estimation to point, spot and directional
 // lights.
 //
-// Approximation (ior != 1 only): lights are delta lights outside the object, so a path
-// vertex inside can reach them only through the refracting boundary, and that connection
-// is itself a delta event. The shadow ray therefore goes along the straight line to the
-// light as if the boundary did not bend it, and is weighted by the Fresnel transmittance
+// Connections to lights through the boundary (ior != 1): lights are delta lights outside
+// the object, so a path vertex inside can reach them only through the refracting
+// boundary, and that connection is itself a delta event. When the mesh's triangles lie in
+// at most 64 planes (a box, any flat-faced solid), each face's refracted path is found
+// exactly (volume/refracted_connection.h): the refracting point, the ray tube's
+// compression, the Fresnel transmittance at the outside angle, the attenuation along the
+// refracted segment; the face must be the first boundary from the vertex and the light
+// visible from the refracting point. Only light that reaches a vertex after specular
+// reflection(s) inside without scattering in between is missed (it crosses the object
+// unscattered: negligible for objects many mean free paths thick).
+// Approximation (ior != 1 and a curved mesh): the shadow ray goes along the straight line
+// to the light as if the boundary did not bend it, weighted by the Fresnel transmittance
 // 1 - F(cos θ) at each crossing, θ being the angle between that line and the surface
-// normal on the outside. Exact when ior == 1. Otherwise the bending of the connection and
-// the solid-angle compression of refraction are ignored, and light that reaches a medium
-// point only after specular reflection(s) at the boundary (internal reflection of the
-// incoming beam) is missed altogether, even at normal incidence. Measured cost: a white
-// furnace (albedo 1, unit sphere, ior 1.4) returns about 75 % of the expected radiance
-// at σt = 0.5, 88 % at σt = 2 and is within its noise of it at σt = 8.
+// normal on the outside. The bending of the connection and the solid-angle compression of
+// refraction are ignored, and internally reflected incoming light is missed. Measured
+// cost: a white furnace (albedo 1, unit sphere, ior 1.4) returns about 75 % of the
+// expected radiance at σt = 0.5, 88 % at σt = 2 and is within its noise of it at σt = 8.
+// exactLightConnections() says which case a scene is.
 #include <cstdint>
 #include <functional>
 #include <glm/vec3.hpp>
@@ -90,6 +97,9 @@ class ReferenceTracer {
   glm::dvec3 majorant() const { return majorant_; }
   /// The per-brick majorants the trackers use.
   const MajorantGrid& majorantGrid() const;
+  /// True when every light connection is exact: ior 1, or a mesh of flat faces (at most
+  /// 64 planes). Otherwise curved faces use the straight-line approximation (see above).
+  bool exactLightConnections() const;
   /// The material field the tracer samples (for checks against the majorants).
   const MaterialField& field() const;
 
