@@ -31,12 +31,14 @@
 //     cell returns to itself the share ρ of the light it sends toward each outside
 //     neighbour: with a linear profile that puts the zero z_b beyond the face for
 //     ρ = (k - 1) / (k + 1), k = 2 z_b / Δx (ρ = 0 when z_b < Δx / 2, at most
-//     kMaxRetention), and light is injected isotropically max(z0, Δx / 2) deep.
+//     kMaxRetention), and light is injected isotropically where the refracted beam
+//     first scatters, max(z0 cos θt, Δx / 2) deep (θt: the beam's angle to the normal).
 //  4. Scales the exitant radiance by a coupling gain G so that a thick slab's diffuse
 //     reflectance is exact. For a semi-infinite layer stack under normal illumination
 //     the lattice's shaded reflectance is, in closed form (derivation in
-//     lpv_calibration.cpp), with the injection depth at layer m* = depth / Δx + 1/2
-//     split linearly between layers m = floor(m*) and m + 1 (fraction f):
+//     lpv_calibration.cpp), with the injection depth max(z0, Δx / 2) at layer
+//     m* = depth / Δx + 1/2 split linearly between layers m = floor(m*) and m + 1
+//     (fraction f):
 //        R_lpv = 3 ((1 - f) r^m + f r^(m+1)) / (s (1 - ρ r)),  r = exp(-κ Δx).
 //     G makes the power the lattice reflects equal the medium's total diffuse reflectance
 //     Rd(α', η) under collimated normal incidence: exact transport in an isotropically
