@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "volume/fresnel.h"
@@ -305,28 +306,38 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
   return result;
 }
 
-double diffuseBoundaryTransmittance(double eta) {
-  if (!(eta > 0.0) || !std::isfinite(eta))
-    throw std::invalid_argument("diffuseBoundaryTransmittance: eta must be positive");
+namespace {
+
+/// The internal Fresnel moments of a smooth boundary: ∫ 2μ (1 - F) dμ (the share of an
+/// isotropic field inside that crosses) and ∫ 2μ F dμ, ∫ 3μ² F dμ (2 C1 and 3 C2), on the
+/// boundary quadrature (split at the critical cosine, where F has a kink).
+struct FresnelMoments {
+  double transmitted = 0.0, twoC1 = 0.0, threeC2 = 0.0;
+};
+
+FresnelMoments fresnelMoments(double eta, const char* caller) {
+  if (!(eta > 0.0) || !std::isfinite(eta)) throw std::invalid_argument(std::string(caller) + ": eta must be positive");
   std::vector<double> mu, w;
   boundaryQuadrature(64, eta, mu, w);
-  double sum = 0.0;
-  for (std::size_t i = 0; i < mu.size(); ++i) sum += 2.0 * w[i] * mu[i] * (1.0 - internalFresnel(mu[i], eta));
-  return sum;
+  FresnelMoments m;
+  for (std::size_t i = 0; i < mu.size(); ++i) {
+    const double reflected = internalFresnel(mu[i], eta);
+    m.transmitted += 2.0 * w[i] * mu[i] * (1.0 - reflected);
+    m.twoC1 += 2.0 * w[i] * mu[i] * reflected;
+    m.threeC2 += 3.0 * w[i] * mu[i] * mu[i] * reflected;
+  }
+  return m;
+}
+
+}  // namespace
+
+double diffuseBoundaryTransmittance(double eta) {
+  return fresnelMoments(eta, "diffuseBoundaryTransmittance").transmitted;
 }
 
 double diffusionBoundaryCoefficient(double eta) {
-  if (!(eta > 0.0) || !std::isfinite(eta))
-    throw std::invalid_argument("diffusionBoundaryCoefficient: eta must be positive");
-  std::vector<double> mu, w;
-  boundaryQuadrature(64, eta, mu, w);
-  double twoC1 = 0.0, threeC2 = 0.0;
-  for (std::size_t i = 0; i < mu.size(); ++i) {
-    const double reflected = internalFresnel(mu[i], eta);
-    twoC1 += 2.0 * w[i] * mu[i] * reflected;
-    threeC2 += 3.0 * w[i] * mu[i] * mu[i] * reflected;
-  }
-  return (1.0 + threeC2) / (1.0 - twoC1);
+  const FresnelMoments m = fresnelMoments(eta, "diffusionBoundaryCoefficient");
+  return (1.0 + m.threeC2) / (1.0 - m.twoC1);
 }
 
 }  // namespace sslpv
