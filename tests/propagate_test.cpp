@@ -285,17 +285,22 @@ TEST(ExitGain, ADenseLessScatteringCellInABrightMediumTakesItsNeighboursGain) {
   EXPECT_EQ(seed.exitGain[0][spot], 1.0f);
 }
 
+/// Paints the dense medium into the cells [first, last]³.
+void paintDenseCube(MaterialGrid& m, int first, int last) {
+  for (int z = first; z <= last; ++z)
+    for (int y = first; y <= last; ++y)
+      for (int x = first; x <= last; ++x) {
+        m.sigmaT[m.frame.index(x, y, z)] = kDenseSigmaT;
+        m.sigmaS[m.frame.index(x, y, z)] = kDenseSigmaS;
+      }
+}
+
 TEST(ExitGain, ALargeDenseRegionKeepsItsOwnGainInside) {
   // The limit reaches two cells: the centre of a 3-cell-wide dense block takes the
   // bright surroundings' gain, the centre of a 7-cell-wide block (four cells from the
   // bright medium) keeps its own, so large uniformly painted regions stay calibrated.
   MaterialGrid m = test::uniformMaterial(13, kBrightSigmaT, kBrightSigmaS, 0.0f, kGainCell);
-  for (int z = 3; z <= 9; ++z)
-    for (int y = 3; y <= 9; ++y)
-      for (int x = 3; x <= 9; ++x) {
-        m.sigmaT[m.frame.index(x, y, z)] = kDenseSigmaT;
-        m.sigmaS[m.frame.index(x, y, z)] = kDenseSigmaS;
-      }
+  paintDenseCube(m, 3, 9);
   const float dense = calibratedTransport(kDenseSigmaT.x, kDenseSigmaS.x, 0.0, kGainCell, 1.0).exitGain;
   const float bright = calibratedTransport(kBrightSigmaT.x, kBrightSigmaS.x, 0.0, kGainCell, 1.0).exitGain;
   ASSERT_NE(dense, bright);
@@ -306,12 +311,7 @@ TEST(ExitGain, ALargeDenseRegionKeepsItsOwnGainInside) {
   EXPECT_EQ(f.exitGain[1][m.frame.index(4, 4, 4)], bright);  // two cells along each axis
 
   MaterialGrid small = test::uniformMaterial(13, kBrightSigmaT, kBrightSigmaS, 0.0f, kGainCell);
-  for (int z = 5; z <= 7; ++z)
-    for (int y = 5; y <= 7; ++y)
-      for (int x = 5; x <= 7; ++x) {
-        small.sigmaT[small.frame.index(x, y, z)] = kDenseSigmaT;
-        small.sigmaS[small.frame.index(x, y, z)] = kDenseSigmaS;
-      }
+  paintDenseCube(small, 5, 7);
   f = computeStepFactors(small, LpvScheme::Calibrated, 1.0);
   EXPECT_EQ(f.exitGain[1][small.frame.index(6, 6, 6)], bright);
 }
