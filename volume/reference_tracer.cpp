@@ -170,15 +170,15 @@ struct ReferenceTracer::Impl {
     const bool directional = light.type == Light::Type::Directional;
     const double value = channelOf(directional ? light.irradiance : light.intensity, c);
     if (!(value > 0.0)) return 0.0;
+    const glm::dvec3 lightDirection = glm::normalize(light.direction);
+    const double spotCosHalf = std::cos(glm::radians(0.5 * light.fovDeg));
     double sum = 0.0;
     for (std::size_t k = 0; k < planes.size(); ++k) {
       const std::optional<RefractedConnection> path =
-          directional ? connectDirectionalLight(x, glm::normalize(light.direction), planes[k], eta)
+          directional ? connectDirectionalLight(x, lightDirection, planes[k], eta)
                       : connectPointLight(x, light.position, planes[k], eta);
       if (!path) continue;
-      if (light.type == Light::Type::Spot &&
-          glm::dot(-path->toLightOutside, glm::normalize(light.direction)) < std::cos(glm::radians(0.5 * light.fovDeg)))
-        continue;
+      if (light.type == Light::Type::Spot && glm::dot(-path->toLightOutside, lightDirection) < spotCosHalf) continue;
       // The path must leave x through this face at y: the first boundary from x is there.
       const RayHit exit = rays->intersect(glm::vec3(x), glm::vec3(path->toLightInside), 0.0f,
                                           float(path->insideDistance * (1.0 + 1e-4) + 10.0 * epsilon));
