@@ -113,10 +113,16 @@ std::string cacheProblem(const fs::path& exr, const fs::path& side, const Refere
 Reference obtainReference(const std::string& sceneArg, const Scene& scene, const fs::path& cacheDir, int spp,
                           std::uint64_t seed) {
   const ReferenceTracer tracer(scene);
-  // References that connect lights exactly through flat dielectric faces differ from the
-  // straight-line ones earlier versions cached under the same scene content.
-  const bool flatFaces = scene.material.ior != 1.0 && tracer.exactLightConnections();
-  ReferenceSidecar want{sceneArg, sceneContentHash(scene, flatFaces ? "exact flat-face light connections" : ""),
+  // Dielectric objects' references connect lights exactly through the boundary, flat faces
+  // since 2026-11-29 and curved ones since 2026-11-30, unlike the straight-line references
+  // earlier versions cached under the same scene content.
+  const char* connection = "";
+  switch (tracer.lightConnection()) {
+    case ReferenceTracer::LightConnection::StraightLine: break;
+    case ReferenceTracer::LightConnection::FlatFaces: connection = "exact flat-face light connections"; break;
+    case ReferenceTracer::LightConnection::Faceted: connection = "exact faceted light connections"; break;
+  }
+  ReferenceSidecar want{sceneArg, sceneContentHash(scene, connection),
                         "", spp, seed, 0.0, scene.camera.width, scene.camera.height};
   const std::string stem = referenceCacheStem(scene, want.hash, spp, seed);
   const fs::path exr = cacheDir / (stem + ".exr"), side = cacheDir / (stem + ".json");

@@ -110,11 +110,6 @@ int runReference(const ReferenceArgs& args) {
 
   const Scene scene = loadScene(args.scene);
   const ReferenceTracer tracer(scene);
-  if (!tracer.exactLightConnections())
-    std::fprintf(stderr,
-                 "reference: note: curved boundary with ior %g: lights are connected along the straight line "
-                 "(an approximation, see README `reference`)\n",
-                 scene.material.ior);
   ReferenceOptions options;
   options.spp = args.spp;
   options.seed = args.seed;

@@ -7,7 +7,7 @@
 // (L radiance, E irradiance): what a user compares in images. For the LPV, whose exit is
 // Lambertian, that is its total diffuse reflectance times the exit Fresnel factor.
 // The path tracer is exact for this scene at any ior (flat face, light at normal
-// incidence: its straight-line connection is the refracted one).
+// incidence: its light connection through the face is a straight line).
 //
 //   slab_calibration [--grid 64] [--spp 256] [--ior jensen|1] [--materials a,b,...]
 #include <algorithm>

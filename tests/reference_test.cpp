@@ -345,13 +345,13 @@ TEST(ReferenceTracer, SingleScatteringMatchesClosedFormBothSides) {
 }
 
 // The same backscatter with a dielectric boundary (η = 1.4) at normal incidence, where
-// the straight-line light connection follows the true refracted path: the camera ray
+// the light connection through the top face is a straight line: the camera ray
 // enters with 1 - F and radiance / η², bounces between the faces with F (series
 // 1/(1 - F² a²), a = exp(-σt d)), and every light connection crosses the top face once
 // more with 1 - F. This is the closed form of the paths the estimator samples; it checks
 // the Fresnel and η² bookkeeping. Physically there is one more term of the size of `up`
-// (the light beam reflected off the bottom face before it scatters), which no straight
-// connection can reach: part of the approximation stated in reference_tracer.h.
+// (the light beam reflected off the bottom face before it scatters), which no direct
+// connection reaches: the paths reference_tracer.h says it misses.
 TEST(ReferenceTracer, SingleScatteringThroughDielectricAtNormalIncidence) {
   const double eta = 1.4;
   const ReferenceTracer tracer(slabScene(eta));
@@ -382,7 +382,7 @@ TEST(ReferenceTracer, SingleScatteringThroughDielectricAtObliqueIncidence) {
   scene.mesh.boxMin.z = -20.0;
   scene.lights[0].direction = glm::dvec3(std::sin(theta1), 0.0, -std::cos(theta1));
   const ReferenceTracer tracer(scene);
-  ASSERT_TRUE(tracer.exactLightConnections());
+  ASSERT_EQ(tracer.lightConnection(), ReferenceTracer::LightConnection::FlatFaces);
   const double cos1 = std::cos(theta1), sin2 = std::sin(theta1) / eta, cos2 = std::sqrt(1.0 - sin2 * sin2);
   const auto fresnel = [&](double cosI) {
     const double cosT = std::sqrt(1.0 - (1.0 - cosI * cosI) / (eta * eta));
@@ -477,13 +477,14 @@ TEST(ReferenceTracer, WhiteFurnaceDielectricBoxWithExactConnections) {
   std::cout << "dielectric box furnace " << e.mean << " +- " << e.standardError << " (exact " << expected << ")\n";
   expectAgrees(e, expected, 0.02, "dielectric box furnace");
   Scene box = slabScene(eta);
-  EXPECT_TRUE(ReferenceTracer(box).exactLightConnections());
+  EXPECT_EQ(ReferenceTracer(box).lightConnection(), ReferenceTracer::LightConnection::FlatFaces);
   box.mesh.kind = MeshSource::Kind::Sphere;
   box.mesh.center = glm::dvec3(0.0);
   box.mesh.radius = 5.0;
-  EXPECT_FALSE(ReferenceTracer(box).exactLightConnections()) << "a curved mesh keeps the straight line";
+  EXPECT_EQ(ReferenceTracer(box).lightConnection(), ReferenceTracer::LightConnection::Faceted);
   box.material.ior = 1.0;
-  EXPECT_TRUE(ReferenceTracer(box).exactLightConnections()) << "index-matched: straight is exact";
+  EXPECT_EQ(ReferenceTracer(box).lightConnection(), ReferenceTracer::LightConnection::StraightLine)
+      << "index-matched: straight is exact";
 }
 
 // A purely absorbing, index-matched object is invisible except for what it hides:

@@ -83,8 +83,8 @@ TEST(SlabReflectance, IndexMatchedSlabMatchesExactHalfSpaceAndDipole) {
   std::cout << r.seconds << " s\n";
 }
 
-// With η = 1.3 the tracer's straight-line light connection is exact for this slab (the
-// light arrives along the normal of a flat face; see slab_reflectance.h), and camera
+// With η = 1.3 the tracer's light connection is exact for this slab (a straight line:
+// the light arrives along the normal of a flat face; see slab_reflectance.h), and camera
 // paths refract and reflect at the boundary exactly. So its Rd must equal an independent
 // 1D walk within 4 combined standard errors. The dipole with its boundary term A(1.3) is
 // printed for reference, not checked: it is not an exact result.

@@ -29,9 +29,14 @@ constexpr double kPi = 3.14159265358979323846;
 /// pathological loops (total internal reflection in an empty region), never by the
 /// estimator in practice; Russian roulette ends ordinary paths long before.
 constexpr int kMaxSegments = 1 << 20;
-// A box has 6 planes; a curved mesh has about as many as triangles, and trying every face
-// at every vertex would cost more than the straight-line connection saves.
+// A box has 6 planes, all tried at every vertex; a curved mesh has about as many as
+// triangles and gets the walk over its faces instead (facetedLight).
 constexpr std::size_t kMaxConnectionPlanes = 64;
+
+/// Curved-mesh light connections attenuated below this along their path inside are
+/// evaluated with probability attenuation / level (facetedLight), never below the floor.
+constexpr double kConnectionRouletteLevel = 0.05;
+constexpr double kConnectionRouletteFloor = 1e-9;
 /// Scattering events before Russian roulette starts.
 constexpr int kRouletteStart = 8;
 
@@ -102,11 +107,14 @@ struct ReferenceTracer::Impl {
   double epsilon = 1e-5;
   MaterialSample base;  ///< the field outside every active voxel's reach
   std::unique_ptr<MajorantGrid> majorants;
-  /// ior != 1 and a mesh of at most kMaxConnectionPlanes planes: lights are connected
-  /// exactly through the flat faces (refractedLight) instead of along the straight line.
+  /// ior != 1: lights are connected exactly through the boundary, by trying every plane
+  /// of a mesh of at most kMaxConnectionPlanes planes (refractedLight), or by the walk
+  /// over the faces of a curved one (facetedLight, `facets` set).
   bool exactConnections = false;
   std::vector<BoundaryPlane> planes;
   std::vector<int> planeOfTriangle;
+  std::unique_ptr<FacetedBoundary> facets;
+  glm::dvec3 minorantSigmaT{0.0};  ///< per channel, the least σt anywhere in the object
 
   struct LightSample {
     glm::dvec3 toLight{0.0};  ///< unit
@@ -162,45 +170,95 @@ struct ReferenceTracer::Impl {
     return tr;
   }
 
+  /// A light's constants for the exact connections, computed once per light and vertex.
+  struct LightView {
+    LightTarget target;
+    double value = 0.0;  ///< intensity (point, spot) or irradiance (directional) in the channel
+    glm::dvec3 direction{0.0};  ///< unit travel direction (directional, spot)
+    double spotCosHalf = -2.0;  ///< below any cosine: no cone
+    LightView(const Light& light, int c) : direction(glm::normalize(light.direction)) {
+      target.directional = light.type == Light::Type::Directional;
+      target.point = target.directional ? direction : light.position;
+      value = channelOf(target.directional ? light.irradiance : light.intensity, c);
+      if (light.type == Light::Type::Spot) spotCosHalf = std::cos(glm::radians(0.5 * light.fovDeg));
+    }
+  };
+
+  /// What one refracted path brings to x, before β: phase × light × the ray tube's geometry
+  /// × Fresnel transmittance × attenuation inside. Zero unless the path really leaves x at
+  /// its refracting point (the first boundary from x is there, on plane `plane` when that
+  /// is given) and reaches the light unobstructed outside.
+  double pathRadiance(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
+                      const RefractedConnection& path, const LightView& view, int plane, int c,
+                      ReferenceRng& rng) const {
+    if (glm::dot(-path.toLightOutside, view.direction) < view.spotCosHalf) return 0.0;
+    const RayHit exit = rays->intersect(glm::vec3(x), glm::vec3(path.toLightInside), 0.0f,
+                                        float(path.insideDistance * (1.0 + 1e-4) + 10.0 * epsilon));
+    if (!exit.hit || (plane >= 0 && planeOfTriangle[exit.triangle] != plane) ||
+        std::abs(double(exit.t) - path.insideDistance) > 1e-4 * path.insideDistance + 10.0 * epsilon)
+      return 0.0;
+    const float outsideFar = std::isfinite(path.outsideDistance) ? float(path.outsideDistance) : 3.0e38f;
+    if (rays->intersect(glm::vec3(path.surfacePoint), glm::vec3(path.toLightOutside), float(epsilon), outsideFar).hit)
+      return 0.0;
+    const double tr = insideTransmittance(field, x, path.toLightInside, path.insideDistance, c, rng);
+    return hgPhase(glm::dot(d, path.toLightInside), g) * view.value * path.geometry *
+           (1.0 - fresnelReflectance(path.cosOutside, eta)) * tr;
+  }
+
   /// In-scattered radiance at x (before β) from `light` through the flat faces of the
   /// boundary (exact connections, refracted_connection.h): per face the refracted path, if
   /// it leaves x through that face and reaches the light unobstructed outside.
   double refractedLight(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
                         const Light& light, int c, ReferenceRng& rng) const {
-    const bool directional = light.type == Light::Type::Directional;
-    const double value = channelOf(directional ? light.irradiance : light.intensity, c);
-    if (!(value > 0.0)) return 0.0;
-    const glm::dvec3 lightDirection = glm::normalize(light.direction);
-    const double spotCosHalf = std::cos(glm::radians(0.5 * light.fovDeg));
+    const LightView view(light, c);
+    if (!(view.value > 0.0)) return 0.0;
     double sum = 0.0;
-    for (std::size_t k = 0; k < planes.size(); ++k) {
-      const std::optional<RefractedConnection> path =
-          directional ? connectDirectionalLight(x, lightDirection, planes[k], eta)
-                      : connectPointLight(x, light.position, planes[k], eta);
-      if (!path) continue;
-      if (light.type == Light::Type::Spot && glm::dot(-path->toLightOutside, lightDirection) < spotCosHalf) continue;
-      // The path must leave x through this face at y: the first boundary from x is there.
-      const RayHit exit = rays->intersect(glm::vec3(x), glm::vec3(path->toLightInside), 0.0f,
-                                          float(path->insideDistance * (1.0 + 1e-4) + 10.0 * epsilon));
-      if (!exit.hit || planeOfTriangle[exit.triangle] != int(k) ||
-          std::abs(double(exit.t) - path->insideDistance) > 1e-4 * path->insideDistance + 10.0 * epsilon)
-        continue;
-      const float outsideFar = std::isfinite(path->outsideDistance) ? float(path->outsideDistance) : 3.0e38f;
-      if (rays->intersect(glm::vec3(path->surfacePoint), glm::vec3(path->toLightOutside), float(epsilon), outsideFar).hit)
-        continue;
-      const double tr = insideTransmittance(field, x, path->toLightInside, path->insideDistance, c, rng);
-      sum += hgPhase(glm::dot(d, path->toLightInside), g) * value * path->geometry *
-             (1.0 - fresnelReflectance(path->cosOutside, eta)) * tr;
-    }
+    for (std::size_t k = 0; k < planes.size(); ++k)
+      if (const std::optional<RefractedConnection> path = connectLight(x, view.target, planes[k], eta))
+        sum += pathRadiance(field, x, d, g, *path, view, int(k), c, rng);
     return sum;
+  }
+
+  /// The same through a curved (faceted) boundary: every face whose refracting point lies
+  /// in it (connectionFaces) contributes; where the beams of neighbouring faces overlap,
+  /// x receives light through each.
+  double facetedLight(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
+                      const Light& light, int c, ReferenceRng& rng) const {
+    const LightView view(light, c);
+    if (!(view.value > 0.0)) return 0.0;
+    double pathLength = 0.0;
+    const int face = connectionWalk(*facets, *rays, x, view.target, eta, &pathLength);
+    // Roulette: light reaching x after more than a few mean free paths inside contributes
+    // little, and the patch search and the shadow rays cost most of the connection.
+    // Evaluating it with probability ∝ its attenuation along the walk's path (weighted by
+    // the inverse) keeps the estimate unbiased; the other paths of the patch are about as
+    // long. The minorant bounds the attenuation from above.
+    double weight = 1.0;
+    if (pathLength > 0.0) {
+      const double keep = std::clamp(std::exp(-minorantSigmaT[c] * pathLength) / kConnectionRouletteLevel,
+                                     kConnectionRouletteFloor, 1.0);
+      if (keep < 1.0) {
+        if (!(rng.uniform() < keep)) return 0.0;
+        weight = 1.0 / keep;
+      }
+    }
+    thread_local std::vector<int> faces;
+    faces.clear();
+    connectionPatch(*facets, face, x, view.target, eta, faces);
+    double sum = 0.0;
+    for (const int lit : faces) {
+      const std::optional<RefractedConnection> path = connectLight(x, view.target, facets->plane(std::size_t(lit)), eta);
+      sum += pathRadiance(field, x, d, g, *path, view, -1, c, rng);
+    }
+    return weight * sum;
   }
 
   /// Residual ratio tracking over the inside parts of origin + t*dir, t in [0, distance],
   /// brick by brick with each brick's minorant and majorant; homogeneous bricks contribute
-  /// exp(-σt·length) exactly. With `fresnel`, each boundary crossing multiplies by the straight-line
-  /// Fresnel transmittance (the approximation stated in the header).
+  /// exp(-σt·length) exactly. Boundaries do not bend the line: the light connection of an
+  /// index-matched object, where they do not.
   double transmittance(const MaterialField::Sampler& field, glm::dvec3 p, const glm::dvec3& dir, double distance,
-                       int c, ReferenceRng& rng, bool fresnel, bool fromVolume) const {
+                       int c, ReferenceRng& rng, bool fromVolume) const {
     double tr = 1.0;
     double remaining = distance;
     for (int segment = 0; segment < kMaxSegments && tr > 0.0; ++segment) {
@@ -212,7 +270,6 @@ struct ReferenceTracer::Impl {
       const double cosN = glm::dot(dir, n);
       const double length = double(hit.t);
       if (cosN > 0.0) tr *= insideTransmittance(field, p, dir, length, c, rng);
-      if (fresnel) tr *= 1.0 - fresnelReflectance(std::abs(cosN), eta);
       p += length * dir;
       remaining -= length;
       if (remaining <= 0.0) break;
@@ -259,12 +316,13 @@ struct ReferenceTracer::Impl {
             beta *= channelOf(m.sigmaS, c) / sigmaT;
             for (const Light& light : scene.lights) {
               if (exactConnections) {
-                radiance += beta * refractedLight(field, x, d, double(m.g), light, c, rng);
+                radiance += beta * (facets ? facetedLight(field, x, d, double(m.g), light, c, rng)
+                                           : refractedLight(field, x, d, double(m.g), light, c, rng));
                 continue;
               }
               const LightSample ls = sampleLight(light, x, c);
               if (ls.value <= 0.0) continue;
-              const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true, true);
+              const double tr = transmittance(field, x, ls.toLight, ls.distance, c, rng, true);
               radiance += beta * hgPhase(glm::dot(d, ls.toLight), double(m.g)) * ls.value * tr;
             }
             ++scatters;
@@ -341,10 +399,17 @@ ReferenceTracer::ReferenceTracer(const Scene& scene, std::shared_ptr<const Mater
   if (impl_->eta != 1.0) {
     std::optional<std::vector<BoundaryPlane>> planes =
         meshPlanes(impl_->object->mesh(), kMaxConnectionPlanes, &impl_->planeOfTriangle);
-    if (planes) {
+    if (planes)
       impl_->planes = std::move(*planes);
-      impl_->exactConnections = true;
-    }
+    else
+      impl_->facets = std::make_unique<FacetedBoundary>(impl_->object->mesh());
+    const MajorantGrid& grid = *impl_->majorants;
+    impl_->minorantSigmaT = grid.globalMajorant();
+    for (int z = 0; z < grid.dims().z; ++z)
+      for (int y = 0; y < grid.dims().y; ++y)
+        for (int x = 0; x < grid.dims().x; ++x)
+          impl_->minorantSigmaT = glm::min(impl_->minorantSigmaT, grid.brick(x, y, z).minorant);
+    impl_->exactConnections = true;
   }
   const Bounds& b = impl_->object->bounds();
   const double extent = std::max({b.max.x - b.min.x, b.max.y - b.min.y, b.max.z - b.min.z, 1e-6});
@@ -362,7 +427,11 @@ double ReferenceTracer::radianceSample(const glm::dvec3& origin, const glm::dvec
 
 const MajorantGrid& ReferenceTracer::majorantGrid() const { return *impl_->majorants; }
 
-bool ReferenceTracer::exactLightConnections() const { return impl_->eta == 1.0 || impl_->exactConnections; }
+
+ReferenceTracer::LightConnection ReferenceTracer::lightConnection() const {
+  if (!impl_->exactConnections) return LightConnection::StraightLine;
+  return impl_->facets ? LightConnection::Faceted : LightConnection::FlatFaces;
+}
 
 const MaterialField& ReferenceTracer::field() const { return impl_->object->field(); }
 
@@ -371,7 +440,7 @@ double ReferenceTracer::estimateTransmittance(const glm::dvec3& a, const glm::dv
   const MaterialField::Sampler field = impl_->object->field().sampler();
   const double distance = glm::length(b - a);
   if (!(distance > 0.0)) return 1.0;
-  return impl_->transmittance(field, a, (b - a) / distance, distance, channel, rng, false, false);
+  return impl_->transmittance(field, a, (b - a) / distance, distance, channel, rng, false);
 }
 
 ReferenceResult ReferenceTracer::render(const ReferenceOptions& options) const {

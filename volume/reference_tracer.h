@@ -18,14 +18,11 @@
 // visible from the refracting point. Only light that reaches a vertex after specular
 // reflection(s) inside without scattering in between is missed (it crosses the object
 // unscattered: negligible for objects many mean free paths thick).
-// Approximation (ior != 1 and a curved mesh): the shadow ray goes along the straight line
-// to the light as if the boundary did not bend it, weighted by the Fresnel transmittance
-// 1 - F(cos θ) at each crossing, θ being the angle between that line and the surface
-// normal on the outside. The bending of the connection and the solid-angle compression of
-// refraction are ignored, and internally reflected incoming light is missed. Measured
-// cost: a white furnace (albedo 1, unit sphere, ior 1.4) returns about 75 % of the
-// expected radiance at σt = 0.5, 88 % at σt = 2 and is within its noise of it at σt = 8.
-// exactLightConnections() says which case a scene is.
+// Curved meshes are connected the same way through their faces (FacetedBoundary): the
+// geometry the camera paths see, whose normals are the flat triangles' own. Before
+// (until 2026-11) they used the straight line to the light with the Fresnel transmittance
+// at the crossing: a white furnace in a unit sphere at ior 1.4 returned 75 % of the
+// right radiance at σt = 0.5 and 88 % at σt = 2.
 #include <cstdint>
 #include <functional>
 #include <glm/vec3.hpp>
@@ -97,9 +94,13 @@ class ReferenceTracer {
   glm::dvec3 majorant() const { return majorant_; }
   /// The per-brick majorants the trackers use.
   const MajorantGrid& majorantGrid() const;
-  /// True when every light connection is exact: ior 1, or a mesh of flat faces (at most
-  /// 64 planes). Otherwise curved faces use the straight-line approximation (see above).
-  bool exactLightConnections() const;
+  /// How lights are connected to path vertices inside (see above).
+  enum class LightConnection {
+    StraightLine,  ///< ior 1: the boundary does not bend light
+    FlatFaces,     ///< every plane of a mesh of at most 64 planes
+    Faceted,       ///< a walk over the faces of a curved mesh
+  };
+  LightConnection lightConnection() const;
   /// The material field the tracer samples (for checks against the majorants).
   const MaterialField& field() const;
 

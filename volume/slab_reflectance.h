@@ -40,8 +40,8 @@ struct SlabReflectance {
 /// Deterministic for a seed whatever the thread count.
 ///
 /// Exact for any ior here: the light arrives along the normal of a flat face, so the
-/// tracer's straight-line light connection (reference_tracer.h) is the true refracted
-/// path, with transmittance 1 - F(0), and the only light it misses is the unscattered
+/// tracer's light connection through the flat face (reference_tracer.h) is a straight
+/// line, with transmittance 1 - F(0), and the only light it misses is the unscattered
 /// beam reflected at the bottom face, attenuated by exp(-σt·depth) ~ exp(-12) or less.
 /// Camera paths handle refraction and internal reflection exactly.
 SlabReflectance estimateSlabReflectance(const MaterialSample& material, double ior,
