@@ -113,13 +113,13 @@ std::string cacheProblem(const fs::path& exr, const fs::path& side, const Refere
 Reference obtainReference(const std::string& sceneArg, const Scene& scene, const fs::path& cacheDir, int spp,
                           std::uint64_t seed) {
   const ReferenceTracer tracer(scene);
-  // Dielectric objects' references connect lights exactly through the boundary, flat faces
-  // since 2026-11-29 and curved ones since 2026-11-30, unlike the straight-line references
-  // earlier versions cached under the same scene content.
+  // Dielectric objects' references connect lights exactly through the boundary: flat faces
+  // since 2026-11-29 (with internal reflections since 2026-11-30) and curved ones since
+  // 2026-11-30, unlike the references earlier versions cached under the same scene content.
   const char* connection = "";
   switch (tracer.lightConnection()) {
     case ReferenceTracer::LightConnection::StraightLine: break;
-    case ReferenceTracer::LightConnection::FlatFaces: connection = "exact flat-face light connections"; break;
+    case ReferenceTracer::LightConnection::FlatFaces: connection = "exact flat-face light connections, internal reflections"; break;
     case ReferenceTracer::LightConnection::Faceted: connection = "exact faceted light connections"; break;
   }
   ReferenceSidecar want{sceneArg, sceneContentHash(scene, connection),
