@@ -31,7 +31,8 @@ TEST(FacetedBoundary, NeighboursShareAnEdge) {
       ASSERT_NE(other, int(t));
       const unsigned a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
       int shared = 0;
-      for (int m = 0; m < 3; ++m) shared += mesh.triangles[std::size_t(other)][m] == a || mesh.triangles[std::size_t(other)][m] == b;
+      for (int m = 0; m < 3; ++m)
+        shared += mesh.triangles[std::size_t(other)][m] == a || mesh.triangles[std::size_t(other)][m] == b;
       EXPECT_EQ(shared, 2) << "triangle " << t << " edge " << k;
     }
   }

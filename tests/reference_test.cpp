@@ -449,7 +449,8 @@ Estimate furnace(double ior, std::shared_ptr<const MaterialSet> set, double l0, 
                  "width": 1, "height": 1}
     })";
     const ReferenceTracer tracer(parseScene(json, "furnace.json"), set, majorants);
-    if (k == 0) tau = opticalDepth(tracer, camera, camera - glm::dvec3(0.0, 0.0, 20.0), glm::dvec3(-1.0), glm::dvec3(1.0), 0);
+    if (k == 0)
+      tau = opticalDepth(tracer, camera, camera - glm::dvec3(0.0, 0.0, 20.0), glm::dvec3(-1.0), glm::dvec3(1.0), 0);
     double sum = 0.0;
     for (int i = 0; i < perGroup; ++i) {
       ReferenceRng rng(21, std::uint64_t(k), std::uint64_t(i));

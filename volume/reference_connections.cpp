@@ -15,14 +15,13 @@ namespace sslpv {
 
 using namespace reference_detail;
 
-double ReferenceTracer::Impl::pathRadiance(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
-                                           const RefractedConnection& path, const LightView& view, int plane, int c,
-                                           ReferenceRng& rng) const {
+double ReferenceTracer::Impl::pathRadiance(const MaterialField::Sampler& field, const glm::dvec3& x,
+                                           const glm::dvec3& d, double g, const RefractedConnection& path,
+                                           const LightView& view, int c, ReferenceRng& rng) const {
   if (glm::dot(-path.toLightOutside, view.direction) < view.spotCosHalf) return 0.0;
   const RayHit exit = rays->intersect(glm::vec3(x), glm::vec3(path.toLightInside), 0.0f,
                                       float(path.insideDistance * (1.0 + 1e-4) + 10.0 * epsilon));
-  if (!exit.hit || (plane >= 0 && planeOfTriangle[exit.triangle] != plane) ||
-      std::abs(double(exit.t) - path.insideDistance) > 1e-4 * path.insideDistance + 10.0 * epsilon)
+  if (!exit.hit || std::abs(double(exit.t) - path.insideDistance) > 1e-4 * path.insideDistance + 10.0 * epsilon)
     return 0.0;
   const float outsideFar = std::isfinite(path.outsideDistance) ? float(path.outsideDistance) : 3.0e38f;
   if (rays->intersect(glm::vec3(path.surfacePoint), glm::vec3(path.toLightOutside), float(epsilon), outsideFar).hit)
@@ -32,8 +31,9 @@ double ReferenceTracer::Impl::pathRadiance(const MaterialField::Sampler& field, 
          (1.0 - fresnelReflectance(path.cosOutside, eta)) * tr;
 }
 
-double ReferenceTracer::Impl::refractedLight(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
-                                             const Light& light, int c, ReferenceRng& rng) const {
+double ReferenceTracer::Impl::refractedLight(const MaterialField::Sampler& field, const glm::dvec3& x,
+                                             const glm::dvec3& d, double g, const Light& light, int c,
+                                             ReferenceRng& rng) const {
   const LightView view(light, c);
   if (!(view.value > 0.0)) return 0.0;
   const bool directional = view.target.directional;
@@ -95,9 +95,10 @@ bool ReferenceTracer::Impl::nearestPlaneIs(const glm::dvec3& p, const glm::dvec3
   return true;
 }
 
-double ReferenceTracer::Impl::reflectedConnection(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& image,
-                                                  const glm::dvec3& d, double g, const LightView& view, const glm::dvec3* inward,
-                                                  const int* mirrors, int m, std::size_t k, int c, ReferenceRng& rng) const {
+double ReferenceTracer::Impl::reflectedConnection(const MaterialField::Sampler& field, const glm::dvec3& x,
+                                                  const glm::dvec3& image, const glm::dvec3& d, double g,
+                                                  const LightView& view, const glm::dvec3* inward, const int* mirrors,
+                                                  int m, std::size_t k, int c, ReferenceRng& rng) const {
   const bool directional = view.target.directional;
   // Directions of the segments from x: the last one is the unfolded direction, known
   // before the connection for a directional light, so that most plane sequences fail the
@@ -168,8 +169,9 @@ double ReferenceTracer::Impl::reflectedConnection(const MaterialField::Sampler& 
          (1.0 - fresnelReflectance(path->cosOutside, eta)) * weight;
 }
 
-double ReferenceTracer::Impl::facetedLight(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
-                                           const Light& light, int c, ReferenceRng& rng) const {
+double ReferenceTracer::Impl::facetedLight(const MaterialField::Sampler& field, const glm::dvec3& x,
+                                           const glm::dvec3& d, double g, const Light& light, int c,
+                                           ReferenceRng& rng) const {
   const LightView view(light, c);
   if (!(view.value > 0.0)) return 0.0;
   double pathLength = 0.0;
@@ -194,7 +196,7 @@ double ReferenceTracer::Impl::facetedLight(const MaterialField::Sampler& field, 
   double sum = 0.0;
   for (const int lit : faces) {
     const std::optional<RefractedConnection> path = connectLight(x, view.target, facets->plane(std::size_t(lit)), eta);
-    sum += pathRadiance(field, x, d, g, *path, view, -1, c, rng);
+    sum += pathRadiance(field, x, d, g, *path, view, c, rng);
   }
   return weight * sum;
 }

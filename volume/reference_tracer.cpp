@@ -106,8 +106,9 @@ ReferenceTracer::Impl::LightSample ReferenceTracer::Impl::sampleLight(const Ligh
   return s;
 }
 
-double ReferenceTracer::Impl::insideTransmittance(const MaterialField::Sampler& field, const glm::dvec3& p, const glm::dvec3& dir,
-                                                  double length, int c, ReferenceRng& rng) const {
+double ReferenceTracer::Impl::insideTransmittance(const MaterialField::Sampler& field, const glm::dvec3& p,
+                                                  const glm::dvec3& dir, double length, int c,
+                                                  ReferenceRng& rng) const {
   double tr = 1.0;
   MajorantGrid::Walker walk(*majorants, p, dir, length);
   MajorantGrid::Segment s;
@@ -130,8 +131,8 @@ double ReferenceTracer::Impl::insideTransmittance(const MaterialField::Sampler& 
   return tr;
 }
 
-double ReferenceTracer::Impl::transmittance(const MaterialField::Sampler& field, glm::dvec3 p, const glm::dvec3& dir, double distance,
-                                            int c, ReferenceRng& rng, bool fromVolume) const {
+double ReferenceTracer::Impl::transmittance(const MaterialField::Sampler& field, glm::dvec3 p, const glm::dvec3& dir,
+                                            double distance, int c, ReferenceRng& rng, bool fromVolume) const {
   double tr = 1.0;
   double remaining = distance;
   for (int segment = 0; segment < kMaxSegments && tr > 0.0; ++segment) {
@@ -150,8 +151,8 @@ double ReferenceTracer::Impl::transmittance(const MaterialField::Sampler& field,
   return tr;
 }
 
-double ReferenceTracer::Impl::trace(const MaterialField::Sampler& field, glm::dvec3 p, glm::dvec3 d, int c, ReferenceRng& rng,
-                                    int maxScatterEvents) const {
+double ReferenceTracer::Impl::trace(const MaterialField::Sampler& field, glm::dvec3 p, glm::dvec3 d, int c,
+                                    ReferenceRng& rng, int maxScatterEvents) const {
   double beta = 1.0;
   double radiance = 0.0;
   int scatters = 0;
@@ -273,8 +274,8 @@ ReferenceTracer::ReferenceTracer(const Scene& scene, std::shared_ptr<const Mater
         meshPlanes(impl_->object->mesh(), kMaxConnectionPlanes, &impl_->planeOfTriangle);
     if (planes) {
       impl_->planes = std::move(*planes);
-      for (std::size_t sequences = impl_->planes.size();
-           impl_->maxReflections < kMaxInternalReflections && sequences * impl_->planes.size() <= kMaxConnectionSequences;
+      for (std::size_t sequences = impl_->planes.size(); impl_->maxReflections < kMaxInternalReflections &&
+                                                         sequences * impl_->planes.size() <= kMaxConnectionSequences;
            sequences *= impl_->planes.size())
         ++impl_->maxReflections;
       const TriangleMesh& mesh = impl_->object->mesh();

@@ -102,12 +102,11 @@ struct ReferenceTracer::Impl {
                              double length, int c, ReferenceRng& rng) const;
 
   /// What one refracted path brings to x, before β: phase × light × the ray tube's geometry
-  /// × Fresnel transmittance × attenuation inside. Zero unless the path really leaves x at
-  /// its refracting point (the first boundary from x is there, on plane `plane` when that
-  /// is given) and reaches the light unobstructed outside.
+  /// × Fresnel transmittance × attenuation inside, for a curved boundary's face. Zero
+  /// unless the path really leaves x at its refracting point (the first boundary from x is
+  /// there) and reaches the light unobstructed outside.
   double pathRadiance(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
-                      const RefractedConnection& path, const LightView& view, int plane, int c,
-                      ReferenceRng& rng) const;
+                      const RefractedConnection& path, const LightView& view, int c, ReferenceRng& rng) const;
 
   /// In-scattered radiance at x (before β) from `light` through the flat faces of the
   /// boundary (exact connections, refracted_connection.h): per face the refracted path, if
