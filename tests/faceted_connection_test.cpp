@@ -87,13 +87,13 @@ std::vector<Connection> everyFace(const FacetedBoundary& boundary, const RayScen
 
 std::vector<Connection> found(const FacetedBoundary& boundary, const RayScene& rays, const glm::dvec3& x,
                               const LightTarget& light, double eta) {
-  std::vector<int> faces;
+  std::vector<FaceConnection> faces;
   connectionFaces(boundary, rays, x, light, eta, faces);
   std::vector<Connection> result;
-  for (int t : faces) {
-    const auto path = connectLight(x, light, boundary.plane(std::size_t(t)), eta);
-    EXPECT_TRUE(path && boundary.contains(std::size_t(t), path->surfacePoint));
-    if (path && leavesThrough(rays, x, *path)) result.push_back({t, path->geometry, path->insideDistance});
+  for (const FaceConnection& f : faces) {
+    const RefractedConnection& path = f.path;
+    EXPECT_TRUE(boundary.contains(std::size_t(f.face), path.surfacePoint));
+    if (leavesThrough(rays, x, path)) result.push_back({f.face, path.geometry, path.insideDistance});
   }
   return result;
 }

@@ -21,6 +21,13 @@ inline double fresnelReflectance(double cosThetaI, double eta) {
   return 0.5 * (rs * rs + rp * rp);
 }
 
+/// Fresnel reflectance for light inside (index eta) arriving at cosInside (> 0) onto the
+/// boundary: 1 beyond the critical angle, else the reflectance of its refracted pair.
+inline double fresnelReflectanceFromInside(double cosInside, double eta) {
+  const double sin2T = eta * eta * (1.0 - cosInside * cosInside);
+  return sin2T >= 1.0 ? 1.0 : fresnelReflectance(std::sqrt(1.0 - sin2T), eta);
+}
+
 /// Direction of the ray refracted into a medium of relative index eta. `incident` is the
 /// unit travel direction, `normal` the unit outward normal (incident . normal < 0).
 inline glm::dvec3 refractInto(const glm::dvec3& incident, const glm::dvec3& normal, double eta) {

@@ -15,6 +15,12 @@ namespace sslpv {
 
 using namespace reference_detail;
 
+double ReferenceTracer::Impl::delivered(const glm::dvec3& d, const glm::dvec3& toLight, double g,
+                                        const LightView& view, const RefractedConnection& path) const {
+  return hgPhase(glm::dot(d, toLight), g) * view.value * path.geometry *
+         (1.0 - fresnelReflectance(path.cosOutside, eta));
+}
+
 double ReferenceTracer::Impl::pathRadiance(const MaterialField::Sampler& field, const glm::dvec3& x,
                                            const glm::dvec3& d, double g, const RefractedConnection& path,
                                            const LightView& view, int c, ReferenceRng& rng) const {
@@ -26,9 +32,8 @@ double ReferenceTracer::Impl::pathRadiance(const MaterialField::Sampler& field, 
   const float outsideFar = std::isfinite(path.outsideDistance) ? float(path.outsideDistance) : 3.0e38f;
   if (rays->intersect(glm::vec3(path.surfacePoint), glm::vec3(path.toLightOutside), float(epsilon), outsideFar).hit)
     return 0.0;
-  const double tr = insideTransmittance(field, x, path.toLightInside, path.insideDistance, c, rng);
-  return hgPhase(glm::dot(d, path.toLightInside), g) * view.value * path.geometry *
-         (1.0 - fresnelReflectance(path.cosOutside, eta)) * tr;
+  return delivered(d, path.toLightInside, g, view, path) *
+         insideTransmittance(field, x, path.toLightInside, path.insideDistance, c, rng);
 }
 
 double ReferenceTracer::Impl::refractedLight(const MaterialField::Sampler& field, const glm::dvec3& x,
@@ -106,8 +111,7 @@ double ReferenceTracer::Impl::reflectedConnection(const MaterialField::Sampler& 
   glm::dvec3 dirs[kMaxInternalReflections + 1];
   std::optional<RefractedConnection> path;
   if (directional) {
-    if (!(glm::dot(view.direction, planes[k].normal) < 0.0)) return 0.0;
-    dirs[m] = inward[k];
+    dirs[m] = inward[k];  // refractedLight passes only planes the light falls on
   } else {
     path = connectPointLight(image, view.target.point, planes[k], eta);
     if (!path) return 0.0;
@@ -147,12 +151,7 @@ double ReferenceTracer::Impl::reflectedConnection(const MaterialField::Sampler& 
           std::abs(double(exit.t) - lengths[i]) > 1e-4 * lengths[i] + 10.0 * epsilon)
         return 0.0;
     }
-    if (i < m) {
-      // Inside reflectance at the inside angle: total beyond the critical angle.
-      const double cosIn = glm::dot(dirs[i], planes[std::size_t(plane)].normal);
-      const double sin2T = eta * eta * (1.0 - cosIn * cosIn);
-      weight *= sin2T >= 1.0 ? 1.0 : fresnelReflectance(std::sqrt(1.0 - sin2T), eta);
-    }
+    if (i < m) weight *= fresnelReflectanceFromInside(glm::dot(dirs[i], planes[std::size_t(plane)].normal), eta);
     p += lengths[i] * dirs[i];
   }
   // A ray leaving a convex mesh never meets it again.
@@ -165,8 +164,7 @@ double ReferenceTracer::Impl::reflectedConnection(const MaterialField::Sampler& 
     weight *= insideTransmittance(field, p, dirs[i], lengths[i], c, rng);
     p += lengths[i] * dirs[i];
   }
-  return hgPhase(glm::dot(d, dirs[0]), g) * view.value * path->geometry *
-         (1.0 - fresnelReflectance(path->cosOutside, eta)) * weight;
+  return delivered(d, dirs[0], g, view, *path) * weight;
 }
 
 double ReferenceTracer::Impl::facetedLight(const MaterialField::Sampler& field, const glm::dvec3& x,
@@ -190,14 +188,11 @@ double ReferenceTracer::Impl::facetedLight(const MaterialField::Sampler& field, 
       weight = 1.0 / keep;
     }
   }
-  thread_local std::vector<int> faces;
-  faces.clear();
-  connectionPatch(*facets, face, x, view.target, eta, faces);
+  thread_local std::vector<FaceConnection> lit;
+  lit.clear();
+  connectionPatch(*facets, face, x, view.target, eta, lit);
   double sum = 0.0;
-  for (const int lit : faces) {
-    const std::optional<RefractedConnection> path = connectLight(x, view.target, facets->plane(std::size_t(lit)), eta);
-    sum += pathRadiance(field, x, d, g, *path, view, c, rng);
-  }
+  for (const FaceConnection& through : lit) sum += pathRadiance(field, x, d, g, through.path, view, c, rng);
   return weight * sum;
 }
 

@@ -221,8 +221,7 @@ double ReferenceTracer::Impl::trace(const MaterialField::Sampler& field, glm::dv
     if (cosN > 0.0) {
       // Leaving the medium. Radiance/n² is invariant across the boundary, so a camera
       // path crossing outwards gains η² (and loses it again on entering).
-      const double sin2T = eta * eta * (1.0 - cosN * cosN);
-      const double reflect = sin2T >= 1.0 ? 1.0 : fresnelReflectance(std::sqrt(1.0 - sin2T), eta);
+      const double reflect = fresnelReflectanceFromInside(cosN, eta);
       if (reflect > 0.0 && rng.uniform() < reflect) {
         d = glm::normalize(d - 2.0 * cosN * n);
       } else {

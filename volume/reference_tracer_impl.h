@@ -101,6 +101,11 @@ struct ReferenceTracer::Impl {
   double insideTransmittance(const MaterialField::Sampler& field, const glm::dvec3& p, const glm::dvec3& dir,
                              double length, int c, ReferenceRng& rng) const;
 
+  /// What a refracted path (leaving x along toLight) delivers before β and before the
+  /// attenuation inside: phase × light × the ray tube's geometry × Fresnel transmittance.
+  double delivered(const glm::dvec3& d, const glm::dvec3& toLight, double g, const LightView& view,
+                   const RefractedConnection& path) const;
+
   /// What one refracted path brings to x, before β: phase × light × the ray tube's geometry
   /// × Fresnel transmittance × attenuation inside, for a curved boundary's face. Zero
   /// unless the path really leaves x at its refracting point (the first boundary from x is
@@ -137,7 +142,7 @@ struct ReferenceTracer::Impl {
                              const int* mirrors, int m, std::size_t k, int c, ReferenceRng& rng) const;
 
   /// The same through a curved (faceted) boundary: every face whose refracting point lies
-  /// in it (connectionFaces) contributes; where the beams of neighbouring faces overlap,
+  /// in it (connectionWalk, connectionPatch) contributes; where the beams of neighbouring faces overlap,
   /// x receives light through each.
   double facetedLight(const MaterialField::Sampler& field, const glm::dvec3& x, const glm::dvec3& d, double g,
                       const Light& light, int c, ReferenceRng& rng) const;

@@ -201,35 +201,31 @@ int connectionWalk(const FacetedBoundary& boundary, const RayScene& rays, const 
 }
 
 void connectionPatch(const FacetedBoundary& boundary, int face, const glm::dvec3& x, const LightTarget& light,
-                     double eta, std::vector<int>& faces) {
+                     double eta, std::vector<FaceConnection>& found) {
   if (face < 0) return;
   // A face whose refracting point lies outside it by less than this many times its size
   // is close enough to the patch that its neighbours may hold theirs.
   constexpr double kNearPatch = 0.25;
   // Breadth-first over neighbours, from the walk's face and then from every face whose
   // refracting point lies in it or near it. The patch is a face or a few, so a flat list
-  // of the faces already tried does.
-  thread_local std::vector<int> tried, queue;
-  tried.assign(1, face);
-  queue.assign(1, face);
-  for (std::size_t next = 0; next < queue.size(); ++next) {
-    const int centre = queue[next];
+  // of the faces queued so far (in order, the queue itself) does.
+  thread_local std::vector<int> queued;
+  queued.assign(1, face);
+  for (std::size_t next = 0; next < queued.size(); ++next) {
+    const int centre = queued[next];
     const std::optional<RefractedConnection> path = connectLight(x, light, boundary.plane(std::size_t(centre)), eta);
     const double clearance = path ? boundary.clearance(std::size_t(centre), path->surfacePoint) : -1e300;
-    if (clearance >= 0.0) faces.push_back(centre);
+    if (clearance >= 0.0) found.push_back({centre, *path});
     // The walk's own face looks around even without a path (x may lie in a gap).
     if (next > 0 && !(clearance >= -kNearPatch * boundary.size(std::size_t(centre)))) continue;
-    for (const int t : boundary.neighbours(std::size_t(centre))) {
-      if (t < 0 || std::find(tried.begin(), tried.end(), t) != tried.end()) continue;
-      tried.push_back(t);
-      queue.push_back(t);
-    }
+    for (const int t : boundary.neighbours(std::size_t(centre)))
+      if (t >= 0 && std::find(queued.begin(), queued.end(), t) == queued.end()) queued.push_back(t);
   }
 }
 
 void connectionFaces(const FacetedBoundary& boundary, const RayScene& rays, const glm::dvec3& x,
-                     const LightTarget& light, double eta, std::vector<int>& faces) {
-  connectionPatch(boundary, connectionWalk(boundary, rays, x, light, eta), x, light, eta, faces);
+                     const LightTarget& light, double eta, std::vector<FaceConnection>& found) {
+  connectionPatch(boundary, connectionWalk(boundary, rays, x, light, eta), x, light, eta, found);
 }
 
 }  // namespace sslpv

@@ -99,8 +99,9 @@ std::optional<RefractedConnection> connectLight(const glm::dvec3& x, const Light
                                                 const BoundaryPlane& plane, double eta);
 
 /// The faces of a curved boundary through which a refracted path from x (inside) to the
-/// light leaves: each face whose refracting point lies in it (appended to `faces`; the
-/// caller still checks that nothing of the boundary lies between x and that point).
+/// light leaves: each face whose refracting point lies in it, with that path (appended to
+/// `found`; the caller still checks that nothing of the boundary lies between x and that
+/// point).
 /// A walk from the face the straight line to the light crosses finds the first: each step
 /// goes to the face that the current face's refracted path points at, until a face holds
 /// its own refracting point (one or two steps on a smooth mesh). Where the beams that
@@ -109,14 +110,18 @@ std::optional<RefractedConnection> connectLight(const glm::dvec3& x, const Light
 /// over the neighbours of the faces found collects it. A cycle, or a face without a
 /// solution, ends the walk where it is: x then lies in a gap between diverging beams, or
 /// near one, and that face's neighbours decide.
+struct FaceConnection {
+  int face = -1;
+  RefractedConnection path;
+};
 void connectionFaces(const FacetedBoundary& boundary, const RayScene& rays, const glm::dvec3& x,
-                     const LightTarget& light, double eta, std::vector<int>& faces);
+                     const LightTarget& light, double eta, std::vector<FaceConnection>& found);
 /// connectionFaces in its two steps. The walk returns the face it ends on (-1: x sees no
 /// boundary towards the light) and, when that face holds its refracting point, the
 /// length of that path inside (else NaN): what the tracer's roulette weighs.
 int connectionWalk(const FacetedBoundary& boundary, const RayScene& rays, const glm::dvec3& x,
                    const LightTarget& light, double eta, double* insideDistance = nullptr);
 void connectionPatch(const FacetedBoundary& boundary, int face, const glm::dvec3& x, const LightTarget& light,
-                     double eta, std::vector<int>& faces);
+                     double eta, std::vector<FaceConnection>& found);
 
 }  // namespace sslpv
