@@ -15,8 +15,8 @@ namespace sslpv::gpu {
 namespace {
 
 // Bindings of shaders/lpv_step_common.glsl and lpv_reduce.comp.
-constexpr std::uint32_t kBindings = 11;
-constexpr bool kTexelBinding[kBindings] = {true, false, false, true, true, false, false, false, false, true, false};
+constexpr std::uint32_t kBindings = 12;
+constexpr bool kTexelBinding[kBindings] = {true, false, false, true, true, false, false, false, false, true, false, true};
 constexpr VkDeviceSize kVec4 = 4 * sizeof(float);
 constexpr VkDeviceSize kFieldVec4PerCell = 3;   // one vec4 of (c0, c1x, c1y, c1z) per channel
 constexpr VkDeviceSize kFactorVec4PerCell = 3;  // (dc.rgb, active), (linear.rgb, 0), (retention.rgb, 0)
@@ -220,7 +220,7 @@ GpuPropagator::GpuPropagator(const VulkanDevice& device, const GridFrame& frame,
   factorsView_ = BufferView(device.handle(), makeTexelView(device, factors_));
   linearSourceView_ = BufferView(device.handle(), makeTexelView(device, linearSource_));
 
-  const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2 * 4},
+  const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2 * 5},
                                          {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * 7}};
   VkDescriptorPoolCreateInfo poolInfo{};
   poolInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
@@ -313,10 +313,10 @@ void GpuPropagator::writeDescriptors() {
     const VkBufferView views[kBindings] = {tiledViews_[k].get(), VK_NULL_HANDLE,  VK_NULL_HANDLE,
                                            tiledAccumulatedView_.get(), factorsView_.get(), VK_NULL_HANDLE,
                                            VK_NULL_HANDLE,       VK_NULL_HANDLE,  VK_NULL_HANDLE,
-                                           linearSourceView_.get(), VK_NULL_HANDLE};
+                                           linearSourceView_.get(), VK_NULL_HANDLE, tiledViews_[1 - k].get()};
     const Buffer* buffers[kBindings] = {nullptr,     &tiled_[1 - k], &tiledAccumulated_, nullptr,
                                         nullptr,     &itemBuffer_,   &partials_,         &control_,
-                                        &stepTotals_, nullptr,       &linearAccumulated_};
+                                        &stepTotals_, nullptr,       &linearAccumulated_, nullptr};
     VkDescriptorBufferInfo infos[kBindings]{};
     VkWriteDescriptorSet writes[kBindings]{};
     for (std::uint32_t b = 0; b < kBindings; ++b) {
@@ -445,6 +445,7 @@ LpvStepPush GpuPropagator::stepPush(const PropagationOptions& options) const {
   push.itemCount = int(itemCount_);
   push.autoSteps = options.autoSteps ? 1 : 0;
   push.autoTolerance = float(options.autoTolerance);
+  push.autoTailTolerance = float(options.autoTailTolerance);
   return push;
 }
 
@@ -543,6 +544,7 @@ PropagationResult GpuPropagator::execute(Mode mode, const PropagationOptions& op
     }
   }
   result.stepsRun = control.stepsRun;
+  result.tailScale = glm::dvec3(control.tailScaleR, control.tailScaleG, control.tailScaleB);
   timings_.steps = result.stepsRun;
   return result;
 }
@@ -571,6 +573,9 @@ PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const P
   control.accumulatedPowerR = float(initialPower.x);
   control.accumulatedPowerG = float(initialPower.y);
   control.accumulatedPowerB = float(initialPower.z);
+  control.previousInGridR = float(initialPower.x);
+  control.previousInGridG = float(initialPower.y);
+  control.previousInGridB = float(initialPower.z);
   PropagationResult result = execute(Mode::Host, options);
   result.initialPower = initialPower;
   transfer(nullptr, &field, tiled_[result.stepsRun % 2], true, false);

@@ -1,8 +1,11 @@
 #version 460
 // Sums the propagation step's per-item partial power sums into one row of step totals,
-// counts the step, and applies the --steps auto rule of volume/propagate.cpp: stop once
-// the step added less than `autoTolerance` of the power accumulated so far, in the worst
-// channel. Keeping the decision on the GPU lets many steps go in one submission.
+// counts the step, and applies the --steps auto rule of decideAutoStop()
+// (volume/propagate.cpp): stop once, in every lit channel, the step added less than
+// `autoTolerance` of the power accumulated so far and the geometric tail r/(1-r) times
+// the step is below `autoTailTolerance` of it; the tail's scale is left in the control
+// record for the accumulation. Keeping the decision on the GPU lets many steps go in one
+// submission.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -44,17 +47,35 @@ void main() {
   const vec3 inGrid = row[3].xyz * float(SSLPV_FLUX_PER_C0);                          // SSLPV_ENERGY_IN_GRID
   const vec3 source = vec3(row[3].w, row[4].xy) * float(SSLPV_FLUX_PER_C0);           // SSLPV_ENERGY_SOURCE
   vec3 accumulatedPower = vec3(control.accumulatedPowerR, control.accumulatedPowerG, control.accumulatedPowerB);
+  vec3 previousInGrid = vec3(control.previousInGridR, control.previousInGridG, control.previousInGridB);
   // A device-resident run starts from the power of the injected light, as the CPU does.
-  if (push.initPower != 0) accumulatedPower = source;
+  if (push.initPower != 0) accumulatedPower = previousInGrid = source;
   accumulatedPower += inGrid;
   control.accumulatedPowerR = accumulatedPower.r;
   control.accumulatedPowerG = accumulatedPower.g;
   control.accumulatedPowerB = accumulatedPower.b;
+  control.previousInGridR = inGrid.r;
+  control.previousInGridG = inGrid.g;
+  control.previousInGridB = inGrid.b;
   control.stepsRun += 1;
   if (push.autoSteps != 0) {
-    float worst = 0.0;
-    for (int ch = 0; ch < 3; ++ch)
-      if (accumulatedPower[ch] > 0.0) worst = max(worst, inGrid[ch] / accumulatedPower[ch]);
-    if (worst < push.autoTolerance) control.stopped = 1;
+    bool stop = true;
+    vec3 tailScale = vec3(0.0);
+    for (int ch = 0; ch < 3; ++ch) {
+      if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > 0.0)) continue;  // a dark channel never holds up a stop
+      const float ratio = previousInGrid[ch] > 0.0 ? inGrid[ch] / previousInGrid[ch] : 0.0;
+      if (!(ratio < 1.0) || inGrid[ch] >= push.autoTolerance * accumulatedPower[ch]) {
+        stop = false;
+        continue;
+      }
+      tailScale[ch] = ratio / (1.0 - ratio);
+      if (inGrid[ch] * tailScale[ch] >= push.autoTailTolerance * accumulatedPower[ch]) stop = false;
+    }
+    if (stop) {
+      control.tailScaleR = tailScale.r;
+      control.tailScaleG = tailScale.g;
+      control.tailScaleB = tailScale.b;
+      control.stopped = 1;
+    }
   }
 }

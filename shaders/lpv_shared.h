@@ -47,25 +47,32 @@ namespace sslpv::gpu {
   X(int, initPower)      /* 1: this step's source power starts the accumulated power */   \
   X(int, accumulate)     /* 0: no; 1: accumulated += source + result; 2: = source + result */ \
   X(int, leftoverParity) /* the accumulation kernel adds the last field if stepsRun % 2 is this */ \
-  X(int, stepLimit)      /* ... once stepsRun reaches this or auto steps stopped */
+  X(int, stepLimit)      /* ... once stepsRun reaches this or auto steps stopped */       \
+  X(float, autoTailTolerance) /* and the estimated power still to come is below this */
 
 struct LpvStepPush {
   SSLPV_LPV_STEP_PUSH_FIELDS(SSLPV_DECLARE_FIELD)
 };
 
 /// std430 record shared by the step kernels: whether propagation has stopped (auto
-/// steps), how many steps ran, and the power accumulated so far (the stopping rule's
-/// denominator, per channel). Written by the reduction, read by every kernel. All zero
-/// is the state before the first step.
+/// steps), how many steps ran, and per channel the power accumulated so far (the
+/// stopping rule's denominator), the power the last step left in the grid (its decay
+/// ratio's denominator) and, once auto steps stop, the multiple of the last step's light
+/// the accumulation adds for the steps not run. Written by the reduction, read by every
+/// kernel. All zero is the state before the first step.
 #define SSLPV_LPV_CONTROL_FIELDS(X) \
   X(int, stopped)                   \
   X(int, stepsRun)                  \
   X(float, accumulatedPowerR)       \
   X(float, accumulatedPowerG)       \
   X(float, accumulatedPowerB)       \
-  X(SSLPV_UINT, pad0)               \
-  X(SSLPV_UINT, pad1)               \
-  X(SSLPV_UINT, pad2)
+  X(float, previousInGridR)         \
+  X(float, previousInGridG)         \
+  X(float, previousInGridB)         \
+  X(float, tailScaleR)              \
+  X(float, tailScaleG)              \
+  X(float, tailScaleB)              \
+  X(SSLPV_UINT, pad0)
 
 struct LpvControl {
   SSLPV_LPV_CONTROL_FIELDS(SSLPV_DECLARE_FIELD)
@@ -101,9 +108,9 @@ struct LpvItem {
 
 #ifdef __cplusplus
 }  // namespace sslpv::gpu
-static_assert(sizeof(sslpv::gpu::LpvStepPush) == 11 * 4, "LpvStepPush must be 4-byte scalars only");
+static_assert(sizeof(sslpv::gpu::LpvStepPush) == 12 * 4, "LpvStepPush must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::LpvStepPush, autoTolerance) == 6 * 4, "LpvStepPush field order");
-static_assert(sizeof(sslpv::gpu::LpvControl) == 8 * 4, "LpvControl must be 4-byte scalars only");
+static_assert(sizeof(sslpv::gpu::LpvControl) == 12 * 4, "LpvControl must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::LpvControl, accumulatedPowerR) == 2 * 4, "LpvControl field order");
 static_assert(sizeof(sslpv::gpu::LpvItem) == 4 * 4, "LpvItem is one uvec4");
 #endif

@@ -31,6 +31,7 @@ layout(std430, binding = 7) readonly buffer Control { SSLPV_LPV_CONTROL_FIELDS(S
 // binding 8: step totals (reduction only).
 layout(binding = 9) uniform samplerBuffer injectedField;  // x-fastest, written by injection
 layout(std430, binding = 10) writeonly buffer OutputField { vec4 accumulatedOut[]; };  // x-fastest
+layout(binding = 11) uniform samplerBuffer otherField;  // the tiled field the step writes (binding 1)
 
 ivec3 dims;
 

@@ -212,7 +212,7 @@ INSTANTIATE_TEST_SUITE_P(
                       StabilityCase{"grid_256", 1.0f, 0.99f, 0.0f, 256, 2}),
     [](const ::testing::TestParamInfo<StabilityCase>& param) { return std::string(param.param.name); });
 
-TEST(Propagation, AutoStepsStopsWhenAStepAddsLittle) {
+TEST(Propagation, AutoStepsStopAtTheFirstStepWithASmallIncrementAndTail) {
   MaterialGrid material = uniformMaterial(16, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f);
   const StepFactors factors = computeStepFactors(material);
   ShGrid field, accumulated;
@@ -221,16 +221,63 @@ TEST(Propagation, AutoStepsStopsWhenAStepAddsLittle) {
   putLobe(field, 8, 8, 8, glm::vec3(0, 1, 0), 1.0f);
   PropagationOptions options;
   options.autoSteps = true;
-  options.autoTolerance = 1e-3;
   options.recordEnergy = true;
   const PropagationResult r = propagate(material, factors, field, accumulated, options);
-  ASSERT_GT(r.stepsRun, 1);
+  ASSERT_GT(r.stepsRun, 2);
   ASSERT_LT(r.stepsRun, options.maxAutoSteps);
+  // The rule, written out on the recorded energies (one channel: all three are equal).
+  const auto stopsAfter = [&](int k, double accumulatedPower) {
+    const double inGrid = r.energy[k].inGrid.x;
+    const double ratio = inGrid / (k == 0 ? r.initialPower.x : r.energy[k - 1].inGrid.x);
+    return inGrid < options.autoTolerance * accumulatedPower &&
+           inGrid * ratio / (1.0 - ratio) < options.autoTailTolerance * accumulatedPower;
+  };
   double accumulatedPower = r.initialPower.x;
-  for (int k = 0; k + 1 < r.stepsRun; ++k) accumulatedPower += r.energy[k].inGrid.x;
-  // The step before the last still added more than the tolerance; the last one did not.
-  EXPECT_GE(r.energy[r.stepsRun - 2].inGrid.x, 1e-3 * (accumulatedPower - r.energy[r.stepsRun - 2].inGrid.x));
-  EXPECT_LT(r.energy.back().inGrid.x, 1e-3 * (accumulatedPower + r.energy.back().inGrid.x));
+  for (int k = 0; k < r.stepsRun; ++k) {
+    accumulatedPower += r.energy[k].inGrid.x;
+    EXPECT_EQ(stopsAfter(k, accumulatedPower), k == r.stepsRun - 1) << "step " << k + 1;
+  }
+  // The stop adds the geometric tail of the last step's light to the accumulated light.
+  const double lastRatio = r.energy.back().inGrid.x / r.energy[r.stepsRun - 2].inGrid.x;
+  EXPECT_NEAR(r.tailScale.x, lastRatio / (1.0 - lastRatio), 1e-12);
+  const double withTail = accumulatedPower + r.tailScale.x * r.energy.back().inGrid.x;
+  EXPECT_NEAR(channelPower(accumulated, 0), withTail, 1e-5 * withTail);
+}
+
+TEST(Propagation, AutoStepsReachTheConvergedLightFarFromTheSource) {
+  // A cube 30 cells across of a nearly white medium (diffusion length 13 cells) behind a
+  // dielectric boundary, lit at the centre of one face: the opposite face fills slowly,
+  // long after the lit side has stopped adding much. The increment rule alone stops
+  // where the far side has a fraction of its light; the tail rule with its extrapolation
+  // must land within 1 % of the converged light there.
+  const MaterialGrid material = uniformMaterial(32, glm::vec3(1.0f), glm::vec3(0.998f), 0.0f);
+  const StepFactors factors = computeStepFactors(material, LpvScheme::Calibrated, 1.4);
+  const auto farEndLight = [&](double stepTolerance, double tailTolerance, int& steps) {
+    ShGrid field, accumulated;
+    field.resize(material.frame);
+    accumulated.resize(material.frame);
+    putLobe(field, 1, 16, 16, glm::vec3(1, 0, 0), 1.0f);
+    PropagationOptions options;
+    options.autoSteps = true;
+    options.autoTolerance = stepTolerance;
+    options.autoTailTolerance = tailTolerance;
+    steps = propagate(material, factors, field, accumulated, options).stepsRun;
+    double sum = 0.0;
+    for (int z = 11; z <= 21; ++z)
+      for (int y = 11; y <= 21; ++y) sum += accumulated.plane(0, 0)[material.frame.index(30, y, z)];
+    return sum;
+  };
+  int convergedSteps = 0, incrementSteps = 0, autoSteps = 0;
+  const double converged = farEndLight(1e-9, 1e-9, convergedSteps);
+  const double incrementOnly = farEndLight(1e-3, 1e30, incrementSteps);
+  const double autoRule = farEndLight(PropagationOptions{}.autoTolerance, PropagationOptions{}.autoTailTolerance,
+                                      autoSteps);
+  std::printf("far face of the cube: increment rule alone %.3f of converged (%d steps), auto %.4f (%d steps), "
+              "converged after %d steps\n",
+              incrementOnly / converged, incrementSteps, autoRule / converged, autoSteps, convergedSteps);
+  ASSERT_LT(convergedSteps, PropagationOptions{}.maxAutoSteps);
+  EXPECT_LT(incrementOnly, 0.9 * converged) << "the case must be one the increment rule gets wrong";
+  EXPECT_NEAR(autoRule, converged, 0.01 * converged);
 }
 
 TEST(GridFrame, TooLargeAGridIsAClearResourceError) {

@@ -77,8 +77,14 @@ struct StepEnergy {
 struct PropagationOptions {
   int steps = 8;
   bool autoSteps = false;
-  /// --steps auto: stop once a step adds less than this fraction of the accumulated power.
+  /// --steps auto stops once both (worst channel, fractions of the power accumulated so
+  /// far) a step adds less than `autoTolerance` and the power still to come, estimated
+  /// as a geometric series from the last step's decay ratio, is below
+  /// `autoTailTolerance`. That estimated tail is then added in the last step's shape.
+  /// Late steps decay by a near-constant ratio r (the slowest mode), so the step rule
+  /// alone stops far too early where r is near 1: the tail is r/(1-r) times the last step.
   double autoTolerance = 1e-3;
+  double autoTailTolerance = 1e-2;
   int maxAutoSteps = 10000;
   bool recordEnergy = false;  ///< fill PropagationResult::energy for every step
 };
@@ -86,6 +92,9 @@ struct PropagationOptions {
 struct PropagationResult {
   int stepsRun = 0;
   glm::dvec3 initialPower{0.0};
+  /// Auto steps: per channel, the multiple of the last step's light added to the
+  /// accumulated light for the steps not run, r/(1-r); 0 when none was added.
+  glm::dvec3 tailScale{0.0};
   std::vector<StepEnergy> energy;  ///< one entry per step when recordEnergy
 };
 
@@ -123,8 +132,22 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme = 
 /// its 6 neighbours (order -x, +x, -y, +y, -z, +z), clamped as the propagation clamps.
 std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz);
 
+/// One --steps auto decision (PropagationOptions::autoTolerance), per channel from the
+/// power in the grid after this step and the previous one (W) and the power accumulated
+/// so far including this step. lpv_reduce.comp applies the same rule on the GPU.
+struct AutoStepDecision {
+  bool stop = false;
+  glm::dvec3 tailScale{0.0};  ///< when stopping: r/(1-r) per channel (0 for dark channels)
+};
+AutoStepDecision decideAutoStop(const glm::dvec3& inGrid, const glm::dvec3& previousInGrid,
+                                const glm::dvec3& accumulatedPower, double stepTolerance, double tailTolerance);
+
+/// accumulated += tailScale[ch] × lastField, per channel: the steps an auto stop skips.
+void addTail(const ShGrid& lastField, const glm::dvec3& tailScale, ShGrid& accumulated);
+
 /// Propagates `field` (the injected light, replaced by the last step's light) for the
-/// requested steps and adds every step, including the injected one, into `accumulated`.
+/// requested steps and adds every step, including the injected one, into `accumulated`
+/// (with auto steps, also the estimated tail of the steps not run).
 /// Each step gathers flux from the 6 neighbours through 5 faces of each destination
 /// (exact face solid angles), re-emits it as cosine lobes, then applies extinction and
 /// scattering. The max(0,·) clamp of the face evaluation is renormalized per source cell

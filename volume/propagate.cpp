@@ -330,6 +330,36 @@ std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz) {
   return flux;
 }
 
+AutoStepDecision decideAutoStop(const glm::dvec3& inGrid, const glm::dvec3& previousInGrid,
+                                const glm::dvec3& accumulatedPower, double stepTolerance, double tailTolerance) {
+  AutoStepDecision decision;
+  decision.stop = true;
+  for (int ch = 0; ch < 3; ++ch) {
+    if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > 0.0)) continue;  // a dark channel never holds up a stop
+    const double ratio = previousInGrid[ch] > 0.0 ? inGrid[ch] / previousInGrid[ch] : 0.0;
+    if (!(ratio < 1.0) || inGrid[ch] >= stepTolerance * accumulatedPower[ch]) {
+      decision.stop = false;
+      continue;
+    }
+    decision.tailScale[ch] = ratio / (1.0 - ratio);
+    if (inGrid[ch] * decision.tailScale[ch] >= tailTolerance * accumulatedPower[ch]) decision.stop = false;
+  }
+  if (!decision.stop) decision.tailScale = glm::dvec3(0.0);
+  return decision;
+}
+
+void addTail(const ShGrid& lastField, const glm::dvec3& tailScale, ShGrid& accumulated) {
+  for (int ch = 0; ch < 3; ++ch) {
+    if (tailScale[ch] == 0.0) continue;
+    const auto scale = float(tailScale[ch]);
+    for (int sh = 0; sh < 4; ++sh) {
+      const std::vector<float>& from = lastField.planes[ch * 4 + sh];
+      std::vector<float>& to = accumulated.planes[ch * 4 + sh];
+      for (std::size_t i = 0; i < to.size(); ++i) to[i] += scale * from[i];
+    }
+  }
+}
+
 PropagationResult propagate(const MaterialGrid& material, const StepFactors& factors, ShGrid& field,
                             ShGrid& accumulated, const PropagationOptions& options) {
   (void)material;
@@ -340,6 +370,7 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
     std::transform(accumulated.planes[k].begin(), accumulated.planes[k].end(), field.planes[k].begin(),
                    accumulated.planes[k].begin(), std::plus<float>());
   glm::dvec3 accumulatedPower = result.initialPower;
+  glm::dvec3 previousInGrid = result.initialPower;
   const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
   if (f.dims.x < 3 || f.dims.y < 3 || f.dims.z < 3) return result;
 
@@ -375,10 +406,14 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
           StepEnergy{total.inGrid, total.emitted - total.gathered, total.absorbed, total.clampRemoved});
     accumulatedPower += total.inGrid;
     if (options.autoSteps) {
-      double worst = 0.0;
-      for (int ch = 0; ch < 3; ++ch)
-        if (accumulatedPower[ch] > 0.0) worst = std::max(worst, total.inGrid[ch] / accumulatedPower[ch]);
-      if (worst < options.autoTolerance) break;
+      const AutoStepDecision decision =
+          decideAutoStop(total.inGrid, previousInGrid, accumulatedPower, options.autoTolerance, options.autoTailTolerance);
+      previousInGrid = total.inGrid;
+      if (decision.stop) {
+        addTail(field, decision.tailScale, accumulated);
+        result.tailScale = decision.tailScale;
+        break;
+      }
     }
   }
   return result;
