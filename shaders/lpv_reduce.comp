@@ -62,7 +62,9 @@ void main() {
     bool stop = true;
     vec3 tailScale = vec3(0.0);
     for (int ch = 0; ch < 3; ++ch) {
-      if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > 0.0)) continue;  // a dark channel never holds up a stop
+      // A dark or fully converged channel never holds up a stop.
+      if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > float(SSLPV_AUTO_STEP_NEGLIGIBLE) * accumulatedPower[ch]))
+        continue;
       const float ratio = previousInGrid[ch] > 0.0 ? inGrid[ch] / previousInGrid[ch] : 0.0;
       if (!(ratio < 1.0) || inGrid[ch] >= push.autoTolerance * accumulatedPower[ch]) {
         stop = false;

@@ -30,6 +30,12 @@
 
 #define SSLPV_PI 3.14159265358979323846
 
+// --steps auto: a channel whose step holds less than this fraction of its accumulated
+// power has converged as far as float sums can tell. Its decay ratio is then rounding
+// noise (on lavapipe, denormals that stall at a ratio of 1), so it neither holds up the
+// stop nor adds a tail; a tail r/(1-r) times this is negligible unless r > 0.9999.
+#define SSLPV_AUTO_STEP_NEGLIGIBLE 1e-6
+
 // The calibrated exit law's table (volume/exit_law.h): rows over t = sqrt(1 - a') at
 // t = k / ALBEDO_INTERVALS, columns over the outside cosine mu_o = j / MU_INTERVALS,
 // row-major, (ALBEDO_INTERVALS + 1) x (MU_INTERVALS + 1) floats, bilinear.

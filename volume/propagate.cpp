@@ -335,7 +335,8 @@ AutoStepDecision decideAutoStop(const glm::dvec3& inGrid, const glm::dvec3& prev
   AutoStepDecision decision;
   decision.stop = true;
   for (int ch = 0; ch < 3; ++ch) {
-    if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > 0.0)) continue;  // a dark channel never holds up a stop
+    // A dark or fully converged channel never holds up a stop.
+    if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > SSLPV_AUTO_STEP_NEGLIGIBLE * accumulatedPower[ch])) continue;
     const double ratio = previousInGrid[ch] > 0.0 ? inGrid[ch] / previousInGrid[ch] : 0.0;
     if (!(ratio < 1.0) || inGrid[ch] >= stepTolerance * accumulatedPower[ch]) {
       decision.stop = false;
