@@ -2,9 +2,9 @@
 // Ends a run of propagation steps, over the same work items. The propagation kernel
 // accumulates two steps at a time (every other step), so the last step may still be
 // missing from the accumulated light: it is added here when the GPU's step count says so
-// (auto steps need no host round trip), and when auto steps stopped, the estimated tail
-// of the steps not run, tailScale times the last step's light. OUTPUT = 1 (device-resident runs) also writes the
-// total into the x-fastest grid that shading reads.
+// (auto steps need no host round trip). When auto steps stopped, so is the estimated
+// tail of the steps not run, tailScale times the last step's light. OUTPUT = 1
+// (device-resident runs) also writes the total into the x-fastest grid that shading reads.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_EXT_control_flow_attributes : require
