@@ -17,6 +17,8 @@ Scene pebbleScene() {
   Scene scene = loadScene(test::examplesDir() / "marble_pebble.json");
   scene.camera.width = scene.camera.height = 96;  // small: the checks are per pixel
   scene.lpv.shadowMap = 96;
+  scene.lpv.autoSteps = false;  // fixed steps: the step-change checks count them
+  scene.lpv.steps = 8;
   return scene;
 }
 

@@ -16,6 +16,8 @@ using namespace sslpv;
 Scene pebbleScene() {
   Scene scene = loadScene(test::examplesDir() / "marble_pebble.json");
   scene.camera.width = scene.camera.height = 128;
+  scene.lpv.autoSteps = false;  // fixed steps: the step-change checks count them
+  scene.lpv.steps = 8;
   return scene;
 }
 
