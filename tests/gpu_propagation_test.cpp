@@ -461,7 +461,6 @@ TEST_F(GpuPropagation, AutoStepsStopAtTheSameStepAsTheCpu) {
     ASSERT_GT(cpu.result.stepsRun, 8) << "the case must need several submissions of 8 steps";
     ASSERT_GT(cpu.result.tailScale.x, 0.0) << "the stop adds a tail, which the GPU must add too";
     stoppedAt[cpu.result.stepsRun % 2] = true;
-    std::printf("%s: %d steps\n", what.c_str(), cpu.result.stepsRun);
     gpu::GpuPropagatorOptions gpuOptions;
     gpuOptions.stepsPerSubmission = 8;  // the stop falls inside a submission
     expectRunsMatch(runGpu(device(), material, injected, options, gpuOptions), cpu, what);

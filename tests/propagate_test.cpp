@@ -39,21 +39,33 @@ TEST(Propagation, IsotropicFieldIsConservedExactly) {
       }
 }
 
+struct LobeRun {
+  PropagationResult result;
+  ShGrid field;        ///< the last step's light
+  ShGrid accumulated;  ///< every step's light
+};
+
+/// Propagates a unit-power cosine lobe put into one cell.
+LobeRun propagateLobe(const MaterialGrid& material, const StepFactors& factors, glm::ivec3 cell, glm::vec3 dir,
+                      const PropagationOptions& options) {
+  LobeRun run;
+  run.field.resize(material.frame);
+  run.accumulated.resize(material.frame);
+  putLobe(run.field, cell.x, cell.y, cell.z, dir, 1.0f);
+  run.result = propagate(material, factors, run.field, run.accumulated, options);
+  return run;
+}
+
 /// Runs `steps` steps from a lobe in the middle of an n³ grid with energy recording.
 PropagationResult runFromLobe(const MaterialGrid& material, int steps, glm::vec3 dir, ShGrid* out = nullptr,
                               LpvScheme scheme = LpvScheme::Seed) {
-  const StepFactors factors = computeStepFactors(material, scheme, 1.4);
-  ShGrid field, accumulated;
-  field.resize(material.frame);
-  accumulated.resize(material.frame);
-  const int c = material.frame.dims.x / 2;
-  putLobe(field, c, c, c, dir, 1.0f);
   PropagationOptions options;
   options.steps = steps;
   options.recordEnergy = true;
-  PropagationResult result = propagate(material, factors, field, accumulated, options);
-  if (out) *out = std::move(field);
-  return result;
+  const int c = material.frame.dims.x / 2;
+  LobeRun run = propagateLobe(material, computeStepFactors(material, scheme, 1.4), glm::ivec3(c), dir, options);
+  if (out) *out = std::move(run.field);
+  return run.result;
 }
 
 TEST(Propagation, EnergyIsConservedStepByStepWhenNothingAbsorbs) {
@@ -214,15 +226,11 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(Propagation, AutoStepsStopAtTheFirstStepWithASmallIncrementAndTail) {
   MaterialGrid material = uniformMaterial(16, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f);
-  const StepFactors factors = computeStepFactors(material);
-  ShGrid field, accumulated;
-  field.resize(material.frame);
-  accumulated.resize(material.frame);
-  putLobe(field, 8, 8, 8, glm::vec3(0, 1, 0), 1.0f);
   PropagationOptions options;
   options.autoSteps = true;
   options.recordEnergy = true;
-  const PropagationResult r = propagate(material, factors, field, accumulated, options);
+  const LobeRun run = propagateLobe(material, computeStepFactors(material), glm::ivec3(8), glm::vec3(0, 1, 0), options);
+  const PropagationResult& r = run.result;
   ASSERT_GT(r.stepsRun, 2);
   ASSERT_LT(r.stepsRun, options.maxAutoSteps);
   // The rule, written out on the recorded energies (one channel: all three are equal).
@@ -241,7 +249,7 @@ TEST(Propagation, AutoStepsStopAtTheFirstStepWithASmallIncrementAndTail) {
   const double lastRatio = r.energy.back().inGrid.x / r.energy[r.stepsRun - 2].inGrid.x;
   EXPECT_NEAR(r.tailScale.x, lastRatio / (1.0 - lastRatio), 1e-12);
   const double withTail = accumulatedPower + r.tailScale.x * r.energy.back().inGrid.x;
-  EXPECT_NEAR(channelPower(accumulated, 0), withTail, 1e-5 * withTail);
+  EXPECT_NEAR(channelPower(run.accumulated, 0), withTail, 1e-5 * withTail);
 }
 
 TEST(Propagation, AutoStepsReachTheConvergedLightFarFromTheSource) {
@@ -253,18 +261,15 @@ TEST(Propagation, AutoStepsReachTheConvergedLightFarFromTheSource) {
   const MaterialGrid material = uniformMaterial(32, glm::vec3(1.0f), glm::vec3(0.998f), 0.0f);
   const StepFactors factors = computeStepFactors(material, LpvScheme::Calibrated, 1.4);
   const auto farEndLight = [&](double stepTolerance, double tailTolerance, int& steps) {
-    ShGrid field, accumulated;
-    field.resize(material.frame);
-    accumulated.resize(material.frame);
-    putLobe(field, 1, 16, 16, glm::vec3(1, 0, 0), 1.0f);
     PropagationOptions options;
     options.autoSteps = true;
     options.autoTolerance = stepTolerance;
     options.autoTailTolerance = tailTolerance;
-    steps = propagate(material, factors, field, accumulated, options).stepsRun;
+    const LobeRun run = propagateLobe(material, factors, glm::ivec3(1, 16, 16), glm::vec3(1, 0, 0), options);
+    steps = run.result.stepsRun;
     double sum = 0.0;
     for (int z = 11; z <= 21; ++z)
-      for (int y = 11; y <= 21; ++y) sum += accumulated.plane(0, 0)[material.frame.index(30, y, z)];
+      for (int y = 11; y <= 21; ++y) sum += run.accumulated.plane(0, 0)[material.frame.index(30, y, z)];
     return sum;
   };
   int convergedSteps = 0, incrementSteps = 0, autoSteps = 0;

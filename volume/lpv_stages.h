@@ -132,19 +132,6 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme = 
 /// its 6 neighbours (order -x, +x, -y, +y, -z, +z), clamped as the propagation clamps.
 std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz);
 
-/// One --steps auto decision (PropagationOptions::autoTolerance), per channel from the
-/// power in the grid after this step and the previous one (W) and the power accumulated
-/// so far including this step. lpv_reduce.comp applies the same rule on the GPU.
-struct AutoStepDecision {
-  bool stop = false;
-  glm::dvec3 tailScale{0.0};  ///< when stopping: r/(1-r) per channel (0 for dark channels)
-};
-AutoStepDecision decideAutoStop(const glm::dvec3& inGrid, const glm::dvec3& previousInGrid,
-                                const glm::dvec3& accumulatedPower, double stepTolerance, double tailTolerance);
-
-/// accumulated += tailScale[ch] × lastField, per channel: the steps an auto stop skips.
-void addTail(const ShGrid& lastField, const glm::dvec3& tailScale, ShGrid& accumulated);
-
 /// Propagates `field` (the injected light, replaced by the last step's light) for the
 /// requested steps and adds every step, including the injected one, into `accumulated`
 /// (with auto steps, also the estimated tail of the steps not run).

@@ -261,6 +261,45 @@ void countOutsideNeighbours(const GridFrame& f, StepFactors& factors) {
   });
 }
 
+/// One --steps auto decision (PropagationOptions::autoTolerance), per channel from the
+/// power in the grid after this step and the previous one (W) and the power accumulated
+/// so far including this step. lpv_reduce.comp applies the same rule on the GPU.
+struct AutoStepDecision {
+  bool stop = false;
+  glm::dvec3 tailScale{0.0};  ///< when stopping: r/(1-r) per channel (0 for dark channels)
+};
+AutoStepDecision decideAutoStop(const glm::dvec3& inGrid, const glm::dvec3& previousInGrid,
+                                const glm::dvec3& accumulatedPower, double stepTolerance, double tailTolerance) {
+  AutoStepDecision decision;
+  decision.stop = true;
+  for (int ch = 0; ch < 3; ++ch) {
+    // A dark or fully converged channel never holds up a stop.
+    if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > SSLPV_AUTO_STEP_NEGLIGIBLE * accumulatedPower[ch])) continue;
+    const double ratio = previousInGrid[ch] > 0.0 ? inGrid[ch] / previousInGrid[ch] : 0.0;
+    if (!(ratio < 1.0) || inGrid[ch] >= stepTolerance * accumulatedPower[ch]) {
+      decision.stop = false;
+      continue;
+    }
+    decision.tailScale[ch] = ratio / (1.0 - ratio);
+    if (inGrid[ch] * decision.tailScale[ch] >= tailTolerance * accumulatedPower[ch]) decision.stop = false;
+  }
+  if (!decision.stop) decision.tailScale = glm::dvec3(0.0);
+  return decision;
+}
+
+/// accumulated += tailScale[ch] × lastField, per channel: the steps an auto stop skips.
+void addTail(const ShGrid& lastField, const glm::dvec3& tailScale, ShGrid& accumulated) {
+  for (int ch = 0; ch < 3; ++ch) {
+    if (tailScale[ch] == 0.0) continue;
+    const auto scale = float(tailScale[ch]);
+    for (int sh = 0; sh < 4; ++sh) {
+      const std::vector<float>& from = lastField.planes[ch * 4 + sh];
+      std::vector<float>& to = accumulated.planes[ch * 4 + sh];
+      for (std::size_t i = 0; i < to.size(); ++i) to[i] += scale * from[i];
+    }
+  }
+}
+
 }  // namespace
 
 StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, double ior) {
@@ -328,37 +367,6 @@ std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz) {
     }
   }
   return flux;
-}
-
-AutoStepDecision decideAutoStop(const glm::dvec3& inGrid, const glm::dvec3& previousInGrid,
-                                const glm::dvec3& accumulatedPower, double stepTolerance, double tailTolerance) {
-  AutoStepDecision decision;
-  decision.stop = true;
-  for (int ch = 0; ch < 3; ++ch) {
-    // A dark or fully converged channel never holds up a stop.
-    if (!(accumulatedPower[ch] > 0.0) || !(inGrid[ch] > SSLPV_AUTO_STEP_NEGLIGIBLE * accumulatedPower[ch])) continue;
-    const double ratio = previousInGrid[ch] > 0.0 ? inGrid[ch] / previousInGrid[ch] : 0.0;
-    if (!(ratio < 1.0) || inGrid[ch] >= stepTolerance * accumulatedPower[ch]) {
-      decision.stop = false;
-      continue;
-    }
-    decision.tailScale[ch] = ratio / (1.0 - ratio);
-    if (inGrid[ch] * decision.tailScale[ch] >= tailTolerance * accumulatedPower[ch]) decision.stop = false;
-  }
-  if (!decision.stop) decision.tailScale = glm::dvec3(0.0);
-  return decision;
-}
-
-void addTail(const ShGrid& lastField, const glm::dvec3& tailScale, ShGrid& accumulated) {
-  for (int ch = 0; ch < 3; ++ch) {
-    if (tailScale[ch] == 0.0) continue;
-    const auto scale = float(tailScale[ch]);
-    for (int sh = 0; sh < 4; ++sh) {
-      const std::vector<float>& from = lastField.planes[ch * 4 + sh];
-      std::vector<float>& to = accumulated.planes[ch * 4 + sh];
-      for (std::size_t i = 0; i < to.size(); ++i) to[i] += scale * from[i];
-    }
-  }
 }
 
 PropagationResult propagate(const MaterialGrid& material, const StepFactors& factors, ShGrid& field,
