@@ -280,6 +280,17 @@ TEST(BenchErrorCache, KeyFollowsTheContentOfTheSceneAndTheFilesItNames) {
   const std::string afterSceneEdit = sceneContentHash(loadScene(dir / "scene.json"));
   EXPECT_NE(afterSceneEdit, original);
 
+  // The LPV settings do not reach the path tracer: adding, then changing them keeps the
+  // key.
+  std::string withLpv = edited;
+  withLpv.insert(withLpv.rfind('}'), R"(, "lpv": {"resolution": 32, "steps": 8})");
+  writeText(dir / "scene.json", withLpv);
+  EXPECT_EQ(sceneContentHash(loadScene(dir / "scene.json")), afterSceneEdit);
+  withLpv.replace(withLpv.find("\"steps\": 8"), 10, "\"steps\": \"auto\"");
+  writeText(dir / "scene.json", withLpv);
+  EXPECT_EQ(sceneContentHash(loadScene(dir / "scene.json")), afterSceneEdit);
+  writeText(dir / "scene.json", edited);
+
   // The mesh file changes, the scene file does not: another reference too.
   writeText(dir / "tetra.obj", std::string(kTetra) + "# moved\n");
   const std::string afterMeshEdit = sceneContentHash(loadScene(dir / "scene.json"));

@@ -112,7 +112,8 @@ struct BenchRunInfo {
 /// one key per CSV column, numbers as numbers, steps_requested a string, pareto a bool}]}.
 std::string benchJson(const BenchRunInfo& info, const std::vector<BenchRow>& rows);
 
-/// FNV-1a 64 of the scene file's bytes and of the mesh and material-set files it names,
+/// FNV-1a 64 of the scene file's JSON without its "lpv" block (which the reference does
+/// not read) and of the bytes of the mesh and material-set files it names,
 /// and of `salt` when not empty (what else the reference depends on, such as the
 /// tracer's light-connection mode), as 16 hex digits: editing any of them changes the
 /// reference. InputError when a file cannot be read.
