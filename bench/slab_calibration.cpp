@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/image_mean.h"
 #include "volume/cpu_renderer.h"
 #include "volume/lpv_calibration.h"
 #include "volume/material.h"
@@ -56,11 +57,7 @@ Scene slabScene(const MeasuredMaterial& material, double ior) {
   return scene;
 }
 
-glm::dvec3 meanReflectance(const Image& image) {
-  glm::dvec3 sum(0.0);
-  for (const glm::vec3& p : image.pixels) sum += glm::dvec3(p);
-  return sum * (M_PI / double(image.pixels.size()));
-}
+glm::dvec3 meanReflectance(const Image& image) { return M_PI * bench::meanRadiance(image); }
 
 }  // namespace
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/image_mean.h"
 #include "volume/cpu_renderer.h"
 #include "volume/material.h"
 #include "volume/reference_tracer.h"
@@ -58,12 +59,6 @@ Scene slabScene(const MeasuredMaterial& material, const Orientation& o) {
   return scene;
 }
 
-glm::dvec3 mean(const Image& image) {
-  glm::dvec3 sum(0.0);
-  for (const glm::vec3& p : image.pixels) sum += glm::dvec3(p);
-  return sum / double(image.pixels.size());
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -105,14 +100,14 @@ int main(int argc, char** argv) {
       ReferenceOptions options;
       options.spp = spp;
       const ReferenceResult truth = ReferenceTracer(scene).render(options);
-      const glm::dvec3 reference = mean(truth.radiance);
+      const glm::dvec3 reference = bench::meanRadiance(truth.radiance);
       // Pixels are independent: the mean's standard error is the pixels' over sqrt(1024).
-      const glm::dvec3 error = mean(truth.standardError) / 32.0;
+      const glm::dvec3 error = bench::meanRadiance(truth.standardError) / 32.0;
       LpvSettings settings;
       settings.resolution = grid;
       settings.autoSteps = true;
       settings.scheme = LpvScheme::Calibrated;
-      const glm::dvec3 lpv = mean(CpuRenderer(scene).render(settings));
+      const glm::dvec3 lpv = bench::meanRadiance(CpuRenderer(scene).render(settings));
       const glm::dvec3 ratio = lpv / reference;
       const double worstSe = std::max({error.x / reference.x, error.y / reference.y, error.z / reference.z});
       std::printf("%-9s %-14s %7.3f %7.3f %7.3f %8.2f%%\n", std::string(material.name).c_str(), o.name, ratio.x,

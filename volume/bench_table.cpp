@@ -266,7 +266,8 @@ std::string sceneContentHash(const Scene& scene, const std::string& salt) {
   };
   // The "lpv" block only steers SSLPV, never the path tracer, so trying another grid or
   // step count in the scene file reuses the reference (minutes of tracing) instead of
-  // keying a new one. Everything else counts byte for byte.
+  // keying a new one. The rest counts by value (layout and key order do not matter); a
+  // scene that is not a JSON object counts byte for byte.
   const std::string sceneBytes = readBytes(scene.file);
   nlohmann::json parsed = nlohmann::json::parse(sceneBytes, nullptr, /*allow_exceptions=*/false);
   if (parsed.is_object()) {
