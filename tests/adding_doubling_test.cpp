@@ -117,6 +117,61 @@ TEST(AddingDoubling, ConvergesInQuadratureOrder) {
   }
 }
 
+// An oblique beam (options.beamCosine) against the same independent walk started at that
+// angle: 4·10^5 photons per case, within 3 standard errors (~7e-4).
+TEST(AddingDoubling, ObliqueBeamMatchesIndependentRandomWalk) {
+  std::uint64_t seed = 300;
+  const double eta = 1.3;  // refracted beams lie in [sqrt(1 - 1/1.69), 1] = [0.64, 1]
+  for (double beamCosine : {0.9, 0.7, 0.65}) {
+    for (double albedo : {0.5, 0.95}) {
+      double standardError = 0.0;
+      const double walk = halfSpaceWalk(albedo, eta, 400000, seed++, standardError, beamCosine);
+      AddingDoublingOptions options;
+      options.beamCosine = beamCosine;
+      const double rd = addingDoublingHalfSpace(albedo, eta, options).rd;
+      EXPECT_NEAR(rd, walk, 3.0 * standardError) << "beam cosine " << beamCosine << " albedo " << albedo;
+    }
+  }
+}
+
+// Two closed forms at any angle: at albedo 1 all the light that enters comes back out;
+// as the albedo goes to 0 (index-matched) only single scattering is left, and a beam at
+// μ0 returns Rd / ω = (1 - μ0 ln(1 + 1/μ0)) / 2 of it (its scatterings at depth τ,
+// ω/μ0 e^(-τ/μ0) dτ, each leave upward at μ with e^(-τ/μ) dμ / 2).
+TEST(AddingDoubling, ObliqueBeamClosedForms) {
+  for (double beamCosine : {1.0, 0.6, 0.3, 0.1}) {
+    AddingDoublingOptions options;
+    options.beamCosine = beamCosine;
+    const double albedo = 1e-6;
+    const double single = 0.5 * (1.0 - beamCosine * std::log(1.0 + 1.0 / beamCosine));
+    // Second-order scattering adds O(albedo) relative.
+    EXPECT_NEAR(addingDoublingHalfSpace(albedo, 1.0, options).rd / albedo, single, 1e-5 * single)
+        << "beam cosine " << beamCosine;
+    // At albedo 1 the stand-in slab still transmits ~1/thickness (as at normal incidence in
+    // ConservesEnergyAtAlbedoZeroAndOne): never more than entered, at most 1e-5 less.
+    const double white = addingDoublingHalfSpace(1.0, 1.0, options).rd;
+    EXPECT_GE(1.0 - white, 0.0) << "beam cosine " << beamCosine;
+    EXPECT_LE(1.0 - white, 1e-5) << "beam cosine " << beamCosine;
+  }
+  for (double beamCosine : {0.95, 0.8, 0.7}) {
+    AddingDoublingOptions options;
+    options.beamCosine = beamCosine;
+    const double eta = 1.4;
+    const double entering = 1.0 - fresnelReflectance(std::sqrt(1.0 - eta * eta * (1.0 - beamCosine * beamCosine)), eta);
+    const double white = addingDoublingHalfSpace(1.0, eta, options).rd;
+    EXPECT_GE(entering - white, 0.0) << "beam cosine " << beamCosine;
+    EXPECT_LE(entering - white, 1e-5) << "beam cosine " << beamCosine;
+  }
+}
+
+TEST(AddingDoubling, BeamCosinesNoOutsideBeamReachesAreRejected) {
+  for (double beamCosine : {0.0, -0.5, 1.5, 0.5}) {  // 0.5: steeper than any refraction at η = 1.3 allows
+    AddingDoublingOptions options;
+    options.beamCosine = beamCosine;
+    EXPECT_THROW(addingDoublingHalfSpace(0.9, 1.3, options), std::invalid_argument) << beamCosine;
+  }
+}
+
 // The exitant power per bin adds up to Rd, and nothing leaves beyond the critical angle.
 TEST(AddingDoubling, ExitFluxSumsToRdAndRespectsTotalInternalReflection) {
   const double eta = 1.3, muC = std::sqrt(1.0 - 1.0 / (eta * eta));

@@ -10,17 +10,20 @@
 
 namespace sslpv::test {
 
-/// Reflected fraction of a collimated normal beam on an isotropically scattering
-/// half-space (σt = 1) with a smooth boundary of relative index eta: an analog random
-/// walk in depth and direction cosine only, with nothing in common with the tracer but
-/// fresnelReflectance. Specular reflection at entry is not counted.
-inline double halfSpaceWalk(double albedo, double eta, int photons, std::uint64_t seed, double& standardError) {
+/// Reflected fraction of a collimated beam on an isotropically scattering half-space
+/// (σt = 1) with a smooth boundary of relative index eta: an analog random walk in depth
+/// and direction cosine only, with nothing in common with the tracer but
+/// fresnelReflectance. The beam runs at `beamCosine` to the normal inside (after
+/// refraction; 1: normal incidence). Specular reflection at entry is not counted.
+inline double halfSpaceWalk(double albedo, double eta, int photons, std::uint64_t seed, double& standardError,
+                            double beamCosine = 1.0) {
   ReferenceRng rng(seed, 0, 0);
-  const double f0 = fresnelReflectance(1.0, eta);
+  const double cosOutside = std::sqrt(1.0 - eta * eta * (1.0 - beamCosine * beamCosine));
+  const double f0 = fresnelReflectance(cosOutside, eta);
   int reflected = 0;
   for (int k = 0; k < photons; ++k) {
     if (rng.uniform() < f0) continue;
-    double z = 0.0, mu = 1.0;  // depth, and direction cosine with +z pointing down
+    double z = 0.0, mu = beamCosine;  // depth, and direction cosine with +z pointing down
     while (true) {
       z -= std::log(1.0 - rng.uniform()) * mu;
       if (z < 0.0) {

@@ -3,7 +3,7 @@
 //
 // Conventions: n bins, matrices row-major n x n, entry (i, j) = power arriving in bin i per
 // unit power incident in bin j, so a column sum is the power a bin's light keeps. The
-// normal beam, not a node, is one more column beside them (r0, t0) plus its unscattered
+// collimated beam, not a node, is one more column beside them (r0, t0) plus its unscattered
 // fraction. The result is the exact solution of the discrete-ordinate equations in the
 // chosen nodes: the starting layer is exact (thinLayer) and doubling is exact algebra, so
 // the only approximation is the quadrature, which converges spectrally in the nodes.
@@ -147,15 +147,15 @@ class Lu {
 
 /// Reflection and transmission of a layer of optical thickness `delta`, exact for the
 /// discrete-ordinate equations. With f+ (f-) the downward (upward) power per bin and b the
-/// normal beam, d/dτ [f+, f-, b] = K [f+, f-, b] with
-///   K = [[S - D, S, s], [-S, D - S, -s], [0, 0, -1]],  D = diag(1/μ), S_ij = ω w_i / (2 μ_j),
-/// s_i = ω w_i / 2 (scattered power per unit depth, isotropic: half into each hemisphere,
+/// beam at direction cosine μ0, d/dτ [f+, f-, b] = K [f+, f-, b] with
+///   K = [[S - D, S, s], [-S, D - S, -s], [0, 0, -1/μ0]],  D = diag(1/μ), S_ij = ω w_i / (2 μ_j),
+/// s_i = ω w_i / (2 μ0) (scattered power per unit depth, isotropic: half into each hemisphere,
 /// shared by solid angle 2π w_i). M = exp(δK) by its Taylor series; nothing enters from
 /// below (f-(δ) = 0) gives R = -M22^-1 M21 and T = M11 + M12 R, the beam's columns alike.
 /// For ω = 1, [1, -1, 1]ᵀ K = 0, so every Taylor term conserves power: the starting layer
 /// neither gains nor loses any, which doubling to great thickness needs.
-void thinLayer(double albedo, const std::vector<double>& mu, const std::vector<double>& w, double delta, Matrix& r,
-               Matrix& t, std::vector<double>& r0, std::vector<double>& t0) {
+void thinLayer(double albedo, const std::vector<double>& mu, const std::vector<double>& w, double beamCosine,
+               double delta, Matrix& r, Matrix& t, std::vector<double>& r0, std::vector<double>& t0) {
   // δK = Λ + p qᵀ: diagonal extinction plus rank-one isotropic scattering, with
   // Λ = δ diag(-1/μ, 1/μ, -1), p = (w, -w, 0), q = δ (ω/2) (1/μ, 1/μ, 1). So each Taylor
   // term costs O(m²): (X δK)_ij = X_ij Λ_j + (X p)_i q_j.
@@ -169,8 +169,9 @@ void thinLayer(double albedo, const std::vector<double>& mu, const std::vector<d
     p[std::size_t(n + i)] = -w[std::size_t(i)];
     q[std::size_t(i)] = q[std::size_t(n + i)] = delta * 0.5 * albedo / mu[std::size_t(i)];
   }
-  lambda[std::size_t(2 * n)] = -delta;
-  q[std::size_t(2 * n)] = delta * 0.5 * albedo;
+  // The beam crosses 1/μ0 of path per unit depth: it is extinguished and scatters that much.
+  lambda[std::size_t(2 * n)] = -delta / beamCosine;
+  q[std::size_t(2 * n)] = delta * 0.5 * albedo / beamCosine;
   Matrix sum(m), term(m);
   for (int i = 0; i < m; ++i) sum(i, i) = term(i, i) = 1.0;
   for (int order = 1; order < 100; ++order) {
@@ -223,6 +224,10 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
   if (options.nodes < 2) throw std::invalid_argument("addingDoublingHalfSpace: need at least 2 nodes");
   if (!(options.transmittanceTolerance > 0.0) || !(options.maxThickness > 0.0))
     throw std::invalid_argument("addingDoublingHalfSpace: tolerance and thickness must be positive");
+  const double mu0 = options.beamCosine;
+  const double sin2Outside = eta * eta * (1.0 - mu0 * mu0);
+  if (!(mu0 > 0.0 && mu0 <= 1.0) || !(sin2Outside < 1.0))
+    throw std::invalid_argument("addingDoublingHalfSpace: no beam from outside refracts to that beam cosine");
 
   HalfSpaceReflectance result;
   boundaryQuadrature(options.nodes, eta, result.mu, result.weight);
@@ -232,14 +237,14 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
 
   // The starting layer: its transfer matrix exp(δK) (see thinLayer) is well conditioned
   // while δ/μ stays near 1 and its Taylor series then converges in ~20 terms.
-  const double muMin = *std::min_element(mu.begin(), mu.end());
+  const double muMin = std::min(mu0, *std::min_element(mu.begin(), mu.end()));
   double delta = 1.0;
   while (delta > 0.5 * muMin) delta *= 0.5;
   const std::size_t bins = mu.size();
   Matrix r(n), t(n);
   std::vector<double> r0(bins), t0(bins);
-  thinLayer(albedo, mu, w, delta, r, t, r0, t0);
-  double direct = std::exp(-delta);  // the normal beam's unscattered fraction
+  thinLayer(albedo, mu, w, mu0, delta, r, t, r0, t0);
+  double direct = std::exp(-delta / mu0);  // the beam's unscattered fraction
 
   Matrix a(n), x(n), tr(n), next(n);
   double thickness = delta;
@@ -288,13 +293,13 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
   result.transmittance = transmittance;
 
   // The boundary: upward power u reaching it is F u reflected back into the same bins,
-  // which the half-space reflects again: u = (1 - F(0)) r0 + R F u.
+  // which the half-space reflects again: u = (1 - F(θi)) r0 + R F u.
   std::vector<double> fresnel(bins);
   for (int i = 0; i < n; ++i) fresnel[std::size_t(i)] = internalFresnel(mu[std::size_t(i)], eta);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) a(i, j) = (i == j ? 1.0 : 0.0) - r(i, j) * fresnel[std::size_t(j)];
   std::vector<double> u = r0;
-  const double entering = 1.0 - fresnelReflectance(1.0, eta);
+  const double entering = 1.0 - fresnelReflectance(std::sqrt(1.0 - sin2Outside), eta);
   for (double& v : u) v *= entering;
   Lu(a).solve(u);
   result.upward = u;

@@ -34,11 +34,16 @@ struct AddingDoublingOptions {
   /// ... or once it is this many mean free paths thick (reached only near albedo 1, where
   /// transmittance falls off as 1/thickness; `transmittance` then reports what is left).
   double maxThickness = 1048576.0;  // 2^20
+  /// Direction cosine, inside the medium, of the collimated beam after refraction: 1 is
+  /// normal incidence. Light arriving outside at cos θi refracts to
+  /// sqrt(1 - (1 - cos² θi) / η²), so for η > 1 it lies in [sqrt(1 - 1/η²), 1].
+  double beamCosine = 1.0;
 };
 
 struct HalfSpaceReflectance {
-  /// Diffusely reflected power per unit incident power of a collimated beam at normal
-  /// incidence: the entry loss 1 - F(0) is included, the specular reflection F(0) is not.
+  /// Diffusely reflected power per unit incident power of the collimated beam
+  /// (AddingDoublingOptions::beamCosine; normal incidence by default): the entry loss
+  /// 1 - F(θi) is included, the specular reflection F(θi) is not.
   double rd = 0.0;
   double thickness = 0.0;      ///< optical thickness of the slab standing in for the half-space
   double transmittance = 0.0;  ///< largest fraction of a bin's power that slab transmits
@@ -59,10 +64,11 @@ struct HalfSpaceReflectance {
 /// Rd of a semi-infinite medium with single-scattering albedo `albedo` in [0, 1] and
 /// isotropic scattering (use the reduced albedo α' for anisotropic media: similarity
 /// relation), boundary of relative index `eta` = n_inside / n_outside > 0, lit by a
-/// collimated beam along the normal. Deterministic; about 0.25 ms with the default
+/// collimated beam (along the normal unless options.beamCosine says otherwise). Deterministic; about 0.25 ms with the default
 /// options (16 nodes: within 1e-8 of the converged value, see adding_doubling_test).
 /// Throws std::invalid_argument for an albedo outside [0, 1], a non-positive or non-finite
-/// eta, fewer than 2 nodes or a non-positive tolerance or thickness.
+/// eta, fewer than 2 nodes, a non-positive tolerance or thickness, or a beam cosine outside
+/// (0, 1] that no beam from outside refracts into.
 HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const AddingDoublingOptions& options = {});
 
 /// Fraction of the power of a Lambertian (uniform-radiance) field inside a medium of
