@@ -70,14 +70,24 @@ Buffer uploadCellCoverage(const VulkanDevice& device, const MaterialGrid& materi
   return uploadBytes(device, values.data(), values.size() * sizeof(float));
 }
 
-Buffer uploadInjectionDepths(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame) {
+Buffer uploadCalibratedInjection(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame) {
+  static_assert(kObliqueIntervals == 4, "one vec4 holds a channel's oblique-entry gain nodes");
   const std::size_t cells = frame.cellCount();
   for (int ch = 0; ch < 3; ++ch)
-    if (factors.injectionDepth[ch].size() != cells)
-      throw GpuError("uploadInjectionDepths: the step factors hold no injection depths for this grid frame");
-  std::vector<float> values(cells * 4, 0.0f);
-  for (std::size_t i = 0; i < cells; ++i)
-    for (int ch = 0; ch < 3; ++ch) values[4 * i + std::size_t(ch)] = factors.injectionDepth[ch][i];
+    if (factors.injectionDepth[ch].size() != cells || factors.obliqueGain[ch].size() != cells * kObliqueIntervals)
+      throw GpuError("uploadCalibratedInjection: the step factors hold no calibrated injection for this grid frame");
+  constexpr std::size_t kFloats = 4 * SSLPV_CALIBRATED_INJECTION_VEC4;
+  std::vector<float> values(cells * kFloats, 0.0f);
+  const auto iorSquared = float(factors.ior * factors.ior);
+  for (std::size_t i = 0; i < cells; ++i) {
+    float* record = &values[kFloats * i];
+    for (int ch = 0; ch < 3; ++ch) {
+      record[ch] = factors.injectionDepth[ch][i];
+      for (int k = 0; k < kObliqueIntervals; ++k)
+        record[4 * (1 + ch) + k] = factors.obliqueGain[ch][i * kObliqueIntervals + std::size_t(k)];
+    }
+    record[3] = iorSquared;
+  }
   return uploadBytes(device, values.data(), values.size() * sizeof(float));
 }
 
@@ -107,13 +117,13 @@ GpuInjector::GpuInjector(const VulkanDevice& device, const GpuInjectorOptions& o
   partials_ =
       Buffer(device, VkDeviceSize(options_.maxWorkgroups) * SSLPV_INJECT_STATS_VEC4 * kVec4, kStorage, MemoryUse::Host);
   sets_.write(0, 3, partials_);
-  noDepths_ = Buffer(device, kVec4, kStorage, MemoryUse::Device);
+  noCalibration_ = Buffer(device, kVec4, kStorage, MemoryUse::Device);
   timestamps_ = TimestampQueries(device, 2);
 }
 
 void GpuInjector::record(VkCommandBuffer cmd, const Buffer& samples, std::uint32_t sampleCount,
                          const Buffer& cellCoverage, const GridFrame& frame, const Buffer& field, bool clearField,
-                         const Buffer* injectionDepths) {
+                         const Buffer* calibratedInjection) {
   const std::size_t cells = frame.cellCount();
   if (cells == 0) throw GpuError("GpuInjector::record: the grid frame has no cells");
   // Field offsets are 12 * cell as 32-bit indices in the shader.
@@ -121,13 +131,15 @@ void GpuInjector::record(VkCommandBuffer cmd, const Buffer& samples, std::uint32
   requireBytes(samples, VkDeviceSize(sampleCount) * sizeof(GpuFluxSample), "sample");
   requireBytes(cellCoverage, VkDeviceSize(cells) * sizeof(float), "cell coverage");
   requireBytes(field, lightFieldBytes(frame), "light field");
-  if (injectionDepths != nullptr) requireBytes(*injectionDepths, VkDeviceSize(cells) * kVec4, "injection depth");
+  if (calibratedInjection != nullptr)
+    requireBytes(*calibratedInjection, VkDeviceSize(cells) * SSLPV_CALIBRATED_INJECTION_VEC4 * kVec4,
+                 "calibrated injection");
 
   // Rewritten every recording, hence one recording in flight per injector (see the class).
   sets_.write(0, 0, samples);
   sets_.write(0, 1, cellCoverage);
   sets_.write(0, 2, field);
-  sets_.write(0, 4, injectionDepths != nullptr ? *injectionDepths : noDepths_);
+  sets_.write(0, 4, calibratedInjection != nullptr ? *calibratedInjection : noCalibration_);
 
   InjectPush push{};
   push.gridOriginX = float(frame.origin.x);
@@ -138,7 +150,7 @@ void GpuInjector::record(VkCommandBuffer cmd, const Buffer& samples, std::uint32
   push.gridDimsY = frame.dims.y;
   push.gridDimsZ = frame.dims.z;
   push.sampleCount = sampleCount;
-  push.calibrated = injectionDepths != nullptr ? 1u : 0u;
+  push.calibrated = calibratedInjection != nullptr ? 1u : 0u;
 
   deviceWritesBarrier(cmd);  // samples, coverage or field written earlier on the queue
   if (clearField) {
@@ -169,11 +181,11 @@ InjectionStats GpuInjector::stats() const {
 
 InjectionStats GpuInjector::run(const Buffer& samples, std::uint32_t sampleCount, const Buffer& cellCoverage,
                                 const GridFrame& frame, const Buffer& field, bool clearField,
-                                const Buffer* injectionDepths) {
+                                const Buffer* calibratedInjection) {
   VkCommandBuffer cmd = commands_.begin();
   timestamps_.reset(cmd);
   timestamps_.write(cmd, 0);
-  record(cmd, samples, sampleCount, cellCoverage, frame, field, clearField, injectionDepths);
+  record(cmd, samples, sampleCount, cellCoverage, frame, field, clearField, calibratedInjection);
   timestamps_.write(cmd, 1);
   commands_.submitAndWait();
   lastRunMs_ = timestamps_.readMilliseconds(2)[1];

@@ -26,10 +26,11 @@ std::vector<float> cellCoverageValues(const MaterialGrid& material);
 /// (submitted and waited for).
 Buffer uploadCellCoverage(const VulkanDevice& device, const MaterialGrid& material);
 
-/// A new device storage buffer holding the calibrated scheme's injection depths of
-/// `factors` (StepFactors::injectionDepth) on `frame`: per cell, x-fastest, (depth rgb, 0).
-/// Throws GpuError when the factors hold no depths (seed scheme) or another frame's.
-Buffer uploadInjectionDepths(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame);
+/// A new device storage buffer holding the calibrated scheme's injection record of
+/// `factors` on `frame` (StepFactors::injectionDepth, ::obliqueGain and ::ior; layout at
+/// SSLPV_CALIBRATED_INJECTION_VEC4 in shaders/cell_coverage_shared.h). Throws GpuError when
+/// the factors hold none (seed scheme) or another frame's.
+Buffer uploadCalibratedInjection(const VulkanDevice& device, const StepFactors& factors, const GridFrame& frame);
 
 /// A new device storage buffer holding `samples` (at least one record's worth of bytes),
 /// e.g. for CPU shadow-map samples injected on the GPU, and for tests.
@@ -61,14 +62,14 @@ class GpuInjector {
   /// `sampleCount` records of `samples` (misses, positionValid.w == 0, are skipped) into
   /// `field` (lightFieldBytes(frame) or more; transfer-dst usage too when cleared).
   /// `cellCoverage` is uploadCellCoverage() of the material on `frame`.
-  /// `injectionDepths` (uploadInjectionDepths()) selects the calibrated scheme's
-  /// isotropic sources at depth; null, the seed's lobes. Barriers before
+  /// `calibratedInjection` (uploadCalibratedInjection()) selects the calibrated scheme's
+  /// isotropic sources at depth, scaled by the oblique-entry gain; null, the seed's lobes. Barriers before
   /// and after make earlier transfer/compute writes visible to the kernel, and its writes
   /// visible to later compute and transfer commands and, after the submission's fence, to
   /// the host (stats()).
   void record(VkCommandBuffer cmd, const Buffer& samples, std::uint32_t sampleCount, const Buffer& cellCoverage,
               const GridFrame& frame, const Buffer& field, bool clearField = true,
-              const Buffer* injectionDepths = nullptr);
+              const Buffer* calibratedInjection = nullptr);
 
   /// Injected and dropped flux of the last recording, once it has executed; summed in
   /// double from per-workgroup float partial sums.
@@ -77,7 +78,7 @@ class GpuInjector {
   /// record() into the injector's own command buffer, submit, wait; returns stats().
   InjectionStats run(const Buffer& samples, std::uint32_t sampleCount, const Buffer& cellCoverage,
                      const GridFrame& frame, const Buffer& field, bool clearField = true,
-                     const Buffer* injectionDepths = nullptr);
+                     const Buffer* calibratedInjection = nullptr);
 
   /// GPU time of the last run() (clear + injection kernel), from timestamps; 0 without them.
   double lastRunMs() const { return lastRunMs_; }
@@ -88,7 +89,7 @@ class GpuInjector {
   ComputePipeline pipeline_;
   StorageBufferSets sets_;
   Buffer partials_;           ///< host-visible: SSLPV_INJECT_STATS_VEC4 vec4 per workgroup
-  Buffer noDepths_;           ///< bound at binding 4 in the seed scheme, never read
+  Buffer noCalibration_;           ///< bound at binding 4 in the seed scheme, never read
   std::uint32_t groups_ = 0;  ///< workgroups of the last recording
   CommandContext commands_;
   TimestampQueries timestamps_;

@@ -76,8 +76,8 @@ void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report)
   }
   factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
   exitFactors_ = std::make_unique<Buffer>(uploadExitFactors(device_, factors_, material_.frame));
-  injectionDepths_ = factors_.scheme == LpvScheme::Calibrated
-                         ? std::make_unique<Buffer>(uploadInjectionDepths(device_, factors_, material_.frame))
+  calibratedInjection_ = factors_.scheme == LpvScheme::Calibrated
+                         ? std::make_unique<Buffer>(uploadCalibratedInjection(device_, factors_, material_.frame))
                          : nullptr;
   report.activeCells = 0;
   for (unsigned char a : factors_.active) report.activeCells += a;
@@ -145,7 +145,7 @@ Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOu
 
   if (dirty_.dirty(Stage::Injection)) {
     report.injection = injector_->run(shadowMapper_->samples(), shadowMapper_->sampleCount(), *cellCoverage_,
-                                      material_.frame, propagator_->sourceField(), true, injectionDepths_.get());
+                                      material_.frame, propagator_->sourceField(), true, calibratedInjection_.get());
     report.times.injection = injector_->lastRunMs();
   } else {
     report.times.markCached(Stage::Injection);

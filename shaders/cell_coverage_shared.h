@@ -39,6 +39,12 @@ namespace sslpv::gpu {
   X(int, gridDimsY)               \
   X(int, gridDimsZ)
 
+/// The calibrated scheme's per-cell injection record (binding 4 of shaders/lpv_inject.comp,
+/// built by sslpv::gpu::uploadCalibratedInjection), x-fastest, this many vec4 per cell:
+/// (injection depth rgb, ior²), then per channel r, g, b a vec4 of the oblique-entry gain
+/// at its SSLPV_OBLIQUE_INTERVALS nodes (StepFactors::obliqueGain).
+#define SSLPV_CALIBRATED_INJECTION_VEC4 4
+
 /// Push constants of shaders/lpv_inject.comp.
 #define SSLPV_INJECT_PUSH_FIELDS(X) \
   SSLPV_CELL_GRID_FIELDS(X)         \

@@ -4,8 +4,9 @@
 // its refracted direction, half a cell inside the surface (a full cell deeper when no
 // active cell is near), spread over active cells with activeTrilinearWeights; in the
 // calibrated scheme (push.calibrated) per channel an isotropic source of the same power at
-// max(depth cos θt, Δx / 2) along the inward normal, the depth read from the surface
-// cell's entry of binding 4 and θt the refracted direction's angle to the normal. Neighbouring samples
+// max(depth cos θt, Δx / 2) along the inward normal, its power times the oblique-entry
+// gain (sslpv::obliqueEntryGain), the depth and the gain's nodes read from the surface
+// cell's record in binding 4 and θt the refracted direction's angle to the normal. Neighbouring samples
 // write the same cells, so the lobes are added with float atomics. Each workgroup also
 // sums the injected and dropped flux of its samples into one row of partial sums, which
 // the host adds in double.
@@ -27,9 +28,19 @@ layout(std430, binding = 0) readonly buffer Samples { GpuFluxSample samples[]; }
 // c1y, c1z), as 12 floats so that each coefficient can be added atomically.
 layout(std430, binding = 2) buffer Field { float field[]; };
 layout(std430, binding = 3) writeonly buffer Stats { vec4 partials[]; };
-// Per cell, x-fastest: (injection depth rgb, 0) of the calibrated scheme
-// (StepFactors::injectionDepth); unread in the seed scheme.
-layout(std430, binding = 4) readonly buffer Depths { vec4 injectionDepth[]; };
+// Per cell, x-fastest, SSLPV_CALIBRATED_INJECTION_VEC4 vec4: (injection depth rgb, ior²)
+// and the oblique-entry gain nodes of r, g and b (cell_coverage_shared.h); unread in the
+// seed scheme.
+layout(std430, binding = 4) readonly buffer Calibration { vec4 calibration[]; };
+
+// sslpv::obliqueEntryGain: piecewise linear in y = cos² θi over nodes at
+// y = 1 - k / SSLPV_OBLIQUE_INTERVALS, k = 1..4, and 1 at y = 1.
+float obliqueEntryGain(vec4 nodes, float y) {
+  const float x = clamp((1.0 - y) * float(SSLPV_OBLIQUE_INTERVALS), 0.0, float(SSLPV_OBLIQUE_INTERVALS));
+  const int k = min(int(x), SSLPV_OBLIQUE_INTERVALS - 1);
+  const float below = k == 0 ? 1.0 : nodes[k - 1], above = nodes[k];
+  return below + (x - float(k)) * (above - below);
+}
 
 shared vec4 injectedSums[SSLPV_INJECT_GROUP];
 shared vec4 droppedSums[SSLPV_INJECT_GROUP];
@@ -71,7 +82,11 @@ void main() {
         if (weights[i] > weights[surface]) surface = i;
       // The refracted beam first scatters about the depth along its path (inject.cpp).
       const float cosRefracted = max(0.0, -dot(rec.direction.xyz, n));
-      const vec3 depths = max(vec3(halfCell), injectionDepth[cells[surface]].xyz * cosRefracted);
+      const uint record = SSLPV_CALIBRATED_INJECTION_VEC4 * cells[surface];
+      const vec4 depthAndIor = calibration[record];
+      const vec3 depths = max(vec3(halfCell), depthAndIor.xyz * cosRefracted);
+      // incidentCosineSquared: cos² θi outside from cos θt inside.
+      const float incidence = clamp(1.0 - depthAndIor.w * (1.0 - cosRefracted * cosRefracted), 0.0, 1.0);
       for (int ch = 0; ch < 3; ++ch) {
         uint deepCells[8];
         float deepWeights[8];
@@ -85,7 +100,8 @@ void main() {
           deepWeights = weights;
         }
         // Isotropic with power Φ: the c0 of a cosine lobe of power Φ, no linear band.
-        const float c0 = float(SSLPV_COSINE_LOBE_C0) * rec.flux[ch] / float(SSLPV_PI);
+        const float gain = obliqueEntryGain(calibration[record + 1u + uint(ch)], incidence);
+        const float c0 = float(SSLPV_COSINE_LOBE_C0) * gain * rec.flux[ch] / float(SSLPV_PI);
         for (int i = 0; i < deepUsed; ++i) atomicAdd(field[12u * deepCells[i] + 4u * uint(ch)], deepWeights[i] * c0);
       }
     }

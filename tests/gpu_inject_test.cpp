@@ -386,7 +386,7 @@ TEST_F(GpuInjection, CalibratedIsotropicSourcesAtDepthMatchTheCpu) {
   const InjectionStats cpuStats = injectSamples(cpuSamples, material, cpu, &factors);
 
   const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), material);
-  const gpu::Buffer depths = gpu::uploadInjectionDepths(device(), factors, material.frame);
+  const gpu::Buffer depths = gpu::uploadCalibratedInjection(device(), factors, material.frame);
   const gpu::Buffer sampleBuffer = gpu::uploadFluxSamples(device(), samples);
   const gpu::Buffer field = makeField(device(), material.frame);
   gpu::GpuInjector injector(device());

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "volume/lpv_calibration.h"
 #include "volume/sh.h"
 
 namespace {
@@ -65,7 +66,7 @@ TEST(Injection, CalibratedSchemeInjectsIsotropicSourcesOneTransportLengthDeep) {
   // σt' per channel 0.25, 0.5, 2 per cell: 1/σt' = 4, 2 and 0.5 cells (the last is the
   // Δx / 2 floor). Light entering along the normal is centred that deep below the top
   // face (z = 15), isotropic, with all its power; entering at 60° to the normal it
-  // starts half as deep (the floor stays).
+  // starts half as deep (the floor stays), its power times the oblique-entry gain.
   MaterialGrid material =
       uniformMaterial(16, glm::vec3(0.25f, 0.5f, 2.0f), glm::vec3(0.2f, 0.45f, 1.9f), 0.0f);
   const StepFactors factors = computeStepFactors(material, LpvScheme::Calibrated, 1.3);
@@ -77,11 +78,19 @@ TEST(Injection, CalibratedSchemeInjectsIsotropicSourcesOneTransportLengthDeep) {
         {{glm::vec3(8.0f, 8.0f, 15.0f), glm::vec3(0, 0, 1), dir, glm::vec3(1.0f, 2.0f, 3.0f)}}, material, grid,
         &factors);
     const double expectedDepth[3] = {4.0 * cosTheta, 2.0 * cosTheta, std::max(0.5, 0.5 * cosTheta)};
+    // A uniform medium: every cell holds the same gain nodes.
+    const std::size_t anyCell = material.frame.index(8, 8, 8);
+    ASSERT_TRUE(factors.active[anyCell]);
     for (int ch = 0; ch < 3; ++ch) {
       const glm::dvec2 depthAndLinear = meanDepthAndLargestLinear(grid, ch);
       EXPECT_NEAR(15.0 - depthAndLinear.x, expectedDepth[ch], 1e-5) << "channel " << ch << " cos " << cosTheta;
       EXPECT_EQ(depthAndLinear.y, 0.0);
-      EXPECT_NEAR(channelPower(grid, ch), ch + 1.0, 1e-5 * (ch + 1.0));
+      const double gain = obliqueEntryGain(&factors.obliqueGain[ch][anyCell * kObliqueIntervals],
+                                           incidentCosineSquared(cosTheta, 1.3));
+      if (cosTheta < 1.0) {
+        EXPECT_GT(std::abs(gain - 1.0), 0.01) << "channel " << ch;  // so the power check is not vacuous
+      }
+      EXPECT_NEAR(channelPower(grid, ch), (ch + 1.0) * gain, 1e-5 * (ch + 1.0));
     }
     EXPECT_EQ(stats.injectedFlux, glm::dvec3(1.0, 2.0, 3.0));
   }

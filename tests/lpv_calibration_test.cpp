@@ -9,6 +9,7 @@
 #include <iostream>
 #include <random>
 #include <stdexcept>
+#include <utility>
 
 #include "lpv_test_grids.h"
 #include "volume/adding_doubling.h"
@@ -97,50 +98,70 @@ TEST(LpvCalibration, RetentionPutsTheLinearProfilesZeroAtTheExtrapolationLength)
   EXPECT_EQ(boundaryRetention(100.0, cellSize), kMaxRetention);
 }
 
+/// A slab 40 x 40 cells wide and 38 deep of one medium (every channel), lit over its
+/// whole top face by one sample per top cell of entering power 1 along the refracted
+/// direction `refracted`, through the real injection and CPU propagation (400 steps, far
+/// beyond what --steps auto resolves). columnPower(z): the power accumulated in layer z
+/// of the middle column, where the side walls (19 cells, 9 diffusion lengths away for
+/// skin green at 0.8 mm) change it by about exp(-9) relative.
+struct WideSlab {
+  MaterialGrid material;
+  StepFactors factors;
+  ShGrid accumulated;
+  int top = 0;
+  double columnPower(int z, int channel = 0) const {
+    const int c = material.frame.dims.x / 2;
+    return accumulated.plane(channel, 0)[material.frame.index(c, c, z)] * SSLPV_FLUX_PER_C0;
+  }
+};
+
+WideSlab litWideSlab(const Medium& medium, double cellSize, double ior, const glm::vec3& refracted) {
+  const int lateral = 40, depth = 40;
+  WideSlab slab;
+  MaterialGrid& m = slab.material;
+  m = uniformMaterial(lateral, glm::vec3(float(medium.sigmaT())), glm::vec3(float(medium.sigmaSPrime)), 0.0f,
+                      cellSize);
+  m.frame.dims = glm::ivec3(lateral, lateral, depth);
+  m.coverage.assign(m.frame.cellCount(), 0.0f);
+  for (int z = 1; z < depth - 1; ++z)
+    for (int y = 1; y < lateral - 1; ++y)
+      for (int x = 1; x < lateral - 1; ++x) m.coverage[m.frame.index(x, y, z)] = 1.0f;
+  m.sigmaT.assign(m.frame.cellCount(), glm::vec3(float(medium.sigmaT())));
+  m.sigmaS.assign(m.frame.cellCount(), glm::vec3(float(medium.sigmaSPrime)));
+  m.g.assign(m.frame.cellCount(), 0.0f);
+  slab.factors = computeStepFactors(m, LpvScheme::Calibrated, ior);
+
+  // One sample per top cell, at its centre on the top face.
+  slab.top = depth - 2;
+  std::vector<SurfaceFluxSample> samples;
+  for (int y = 1; y < lateral - 1; ++y)
+    for (int x = 1; x < lateral - 1; ++x)
+      samples.push_back({glm::vec3(float((x + 0.5) * cellSize), float((y + 0.5) * cellSize),
+                                   float((slab.top + 1) * cellSize)),
+                         glm::vec3(0, 0, 1), refracted, glm::vec3(1.0f)});
+  ShGrid field;
+  field.resize(m.frame);
+  slab.accumulated.resize(m.frame);
+  injectSamples(samples, m, field, &slab.factors);
+  PropagationOptions options;
+  options.steps = 400;
+  propagate(m, slab.factors, field, slab.accumulated, options);
+  return slab;
+}
+
 TEST(LpvCalibration, SurvivalAndRetentionGiveTheClosedFormLattice) {
   // Laterally uniform light in the calibrated lattice decays by r = exp(-κ Δx) per
   // layer: that is what s = 3/(2 + cosh(κ Δx)) was derived for. Run the real injection
-  // and CPU propagation on a wide slab lit over its whole top and read the decay in its
-  // middle. The closed form holds exactly below the injected layers, for an infinitely
-  // wide slab: the side walls, 19 cells = 9 diffusion lengths from the middle, change it
-  // by about exp(-9) relative.
+  // and CPU propagation on a wide slab lit over its whole top (litWideSlab) and read the
+  // decay in its middle. The closed form holds exactly below the injected layers, for an
+  // infinitely wide slab.
   for (double ior : {1.0, 1.4}) {
     const Medium skin{0.88, 0.17};  // Jensen skin1, green, per mm
     const double cellSize = 0.8;
-    const int lateral = 40, depth = 40;
-    MaterialGrid m = uniformMaterial(lateral, glm::vec3(float(skin.sigmaT())),
-                                     glm::vec3(float(skin.sigmaSPrime)), 0.0f, cellSize);
-    m.frame.dims = glm::ivec3(lateral, lateral, depth);
-    m.coverage.assign(m.frame.cellCount(), 0.0f);
-    for (int z = 1; z < depth - 1; ++z)
-      for (int y = 1; y < lateral - 1; ++y)
-        for (int x = 1; x < lateral - 1; ++x) m.coverage[m.frame.index(x, y, z)] = 1.0f;
-    m.sigmaT.assign(m.frame.cellCount(), glm::vec3(float(skin.sigmaT())));
-    m.sigmaS.assign(m.frame.cellCount(), glm::vec3(float(skin.sigmaSPrime)));
-    m.g.assign(m.frame.cellCount(), 0.0f);
-    const StepFactors factors = computeStepFactors(m, LpvScheme::Calibrated, ior);
-
-    // One sample per top cell, at its centre on the top face, entering along -z.
-    const int top = depth - 2;
-    std::vector<SurfaceFluxSample> samples;
-    for (int y = 1; y < lateral - 1; ++y)
-      for (int x = 1; x < lateral - 1; ++x)
-        samples.push_back({glm::vec3(float((x + 0.5) * cellSize), float((y + 0.5) * cellSize),
-                                     float((top + 1) * cellSize)),
-                           glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::vec3(1.0f)});
-    ShGrid field, accumulated;
-    field.resize(m.frame);
-    accumulated.resize(m.frame);
-    injectSamples(samples, m, field, &factors);
-    // Fixed steps, run to convergence far below what --steps auto resolves (it stops a
-    // channel once a step holds 1e-6 of its power; the layers read here need less).
-    PropagationOptions options;
-    options.steps = 400;
-    propagate(m, factors, field, accumulated, options);
-
-    const int c = lateral / 2;
+    const WideSlab slab = litWideSlab(skin, cellSize, ior, glm::vec3(0, 0, -1));
+    const int top = slab.top;
     const double r = std::exp(-skin.kappa() * cellSize);
-    const auto power = [&](int z) { return accumulated.plane(0, 0)[m.frame.index(c, c, z)] * SSLPV_FLUX_PER_C0; };
+    const auto power = [&](int z) { return slab.columnPower(z); };
     // 5e-4 relative: the field is accumulated in float32 over 400 steps.
     for (int z = top - 2; z >= top - 9; --z)
       EXPECT_NEAR(power(z - 1) / power(z), r, 5e-4 * r) << "ior " << ior << " layer " << z;
@@ -229,6 +250,84 @@ TEST(LpvCalibration, ExitGainMakesTheLatticeReflectTheMediumsRd) {
       }
     }
   }
+}
+
+// The oblique-entry gain (lpv_calibration.h, point 5), end to end through the real
+// injection and propagation: light entering the wide slab at θi must come back out as the
+// medium's Rd(θi) per entering power from adding-doubling, as normal incidence does. At a
+// node of the gain (cos² θi = 0.5, 0.25) only float accumulation separates them; between
+// nodes (cos² θi = 0.65) the gain is linear in cos² θi, within 0.5 %.
+TEST(LpvCalibration, ObliqueEntryGainMakesTheLatticeReflectTheMediumsRdAtEveryAngle) {
+  const double ior = 1.4, cellSize = 0.8;
+  const Medium skin{0.88, 0.17};  // Jensen skin1, green, per mm: injected 1.2 cells deep
+  const double leaving = diffuseBoundaryTransmittance(ior);
+  const double gain = calibratedTransport(skin.sigmaT(), skin.sigmaSPrime, 0.0, cellSize, ior).exitGain;
+  for (const auto& [incidence, tolerance] : {std::pair{1.0, 5e-4}, {0.5, 5e-4}, {0.25, 5e-4}, {0.65, 5e-3}}) {
+    const double cosRefracted = std::sqrt(1.0 - (1.0 - incidence) / (ior * ior));
+    const glm::vec3 refracted(float(std::sqrt(1.0 - cosRefracted * cosRefracted)), 0.0f, -float(cosRefracted));
+    const WideSlab slab = litWideSlab(skin, cellSize, ior, refracted);
+    // Shading reads the top layer as an isotropic cell: out goes gain · power / 2 · leaving
+    // per entering power (the derivation in lpv_calibration.cpp).
+    const double reflected = gain * 0.5 * slab.columnPower(slab.top) * leaving;
+    AddingDoublingOptions options;
+    options.beamCosine = cosRefracted;
+    const double medium = addingDoublingHalfSpace(skin.albedo(), ior, options).rd /
+                          (1.0 - fresnelReflectance(std::sqrt(incidence), ior));
+    EXPECT_NEAR(reflected, medium, tolerance * medium) << "cos^2 of incidence " << incidence;
+  }
+}
+
+// Cells far wider than the injection depth inject at the half-cell floor at every angle,
+// so their oblique-entry gain is the medium's ratio alone: Rd per entering power at the
+// node's incidence over that at normal incidence. Between the table's albedo nodes it must
+// still be adding-doubling's, to 1e-4.
+TEST(LpvCalibration, ObliqueRatioTableMatchesAddingDoubling) {
+  for (double ior : {1.0, 1.3, 1.5}) {
+    for (int i = 0; i < 32; ++i) {
+      const double t = (i + 0.5) / 32.0, albedo = 1.0 - t * t;
+      const CellTransport wide = calibratedTransport(1.0, albedo, 0.0, 100.0, ior);
+      const auto perEntering = [&](double incidence) {
+        AddingDoublingOptions options;
+        options.beamCosine = std::sqrt(1.0 - (1.0 - incidence) / (ior * ior));
+        return addingDoublingHalfSpace(albedo, ior, options).rd / (1.0 - fresnelReflectance(std::sqrt(incidence), ior));
+      };
+      for (int k = 1; k <= kObliqueIntervals; ++k) {
+        // The grazing node holds cos θi = 0.03 (and for η < 1 nothing flatter than enters).
+        const double incidence = std::max(1.0 - double(k) / kObliqueIntervals, 0.03 * 0.03);
+        const double expected = perEntering(incidence) / perEntering(1.0);
+        EXPECT_NEAR(wide.obliqueGain[std::size_t(k - 1)], expected, 1e-4 * expected)
+            << "ior " << ior << " albedo " << albedo << " node " << k;
+      }
+    }
+  }
+}
+
+TEST(LpvCalibration, ObliqueEntryGainIsPiecewiseLinearInTheIncidenceCosineSquared) {
+  const float nodes[kObliqueIntervals] = {0.9f, 0.8f, 0.75f, 0.7f};  // at cos² θi = 0.75, 0.5, 0.25, 0
+  EXPECT_DOUBLE_EQ(obliqueEntryGain(nodes, 1.0), 1.0);
+  EXPECT_NEAR(obliqueEntryGain(nodes, 0.875), 0.95, 1e-7);
+  EXPECT_NEAR(obliqueEntryGain(nodes, 0.5), 0.8, 1e-7);
+  EXPECT_NEAR(obliqueEntryGain(nodes, 0.125), 0.725, 1e-7);
+  EXPECT_NEAR(obliqueEntryGain(nodes, 0.0), 0.7, 1e-7);
+  EXPECT_NEAR(obliqueEntryGain(nodes, -0.5), 0.7, 1e-7);  // clamped
+  EXPECT_DOUBLE_EQ(incidentCosineSquared(1.0, 1.3), 1.0);
+  EXPECT_NEAR(incidentCosineSquared(std::sqrt(1.0 - 0.25 / 1.69), 1.3), 0.75, 1e-12);
+  EXPECT_EQ(incidentCosineSquared(0.1, 1.3), 0.0);  // steeper than refraction allows
+  // The seed's factors carry a gain of 1 at every angle.
+  for (float node : seedTransport(1.0, 0.5, 0.0, 0.5).obliqueGain) EXPECT_EQ(node, 1.0f);
+}
+
+TEST(LpvCalibration, StaircaseExitCorrectionUndoesTheDilutionOfUnpropagatedLight) {
+  EXPECT_DOUBLE_EQ(staircaseExitCorrection(0.6, 1.0), 1.0);  // an aligned face
+  EXPECT_DOUBLE_EQ(staircaseExitCorrection(0.0, std::sqrt(2.0)), 1.0);  // all light propagated
+  // Half the light unpropagated, diluted by |n|_1 = sqrt 2 at 45°: 1 / (0.5 + 0.5 / sqrt 2).
+  EXPECT_NEAR(staircaseExitCorrection(0.5, std::sqrt(2.0)), 1.0 / (0.5 + 0.5 / std::sqrt(2.0)), 1e-12);
+  // The share: all of it when nothing propagates (survival 0 is absorbed at once, so none
+  // is read back; a tiny survival keeps nearly all of what layer 1 holds unpropagated).
+  const CellTransport dense = calibratedTransport(50.0, 0.5, 0.0, 1.0, 1.3);  // κ Δx = 50: s ~ 1e-21
+  EXPECT_NEAR(dense.freshShare, 1.0, 1e-6);
+  const CellTransport deep = calibratedTransport(0.25, 0.2, 0.0, 0.5, 1.3);  // injected 8 cells deep
+  EXPECT_EQ(deep.freshShare, 0.0f);
 }
 
 TEST(LpvCalibration, SeedSchemeIsTheSeedsFormula) {

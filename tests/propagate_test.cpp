@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "lpv_test_grids.h"
+#include "volume/adding_doubling.h"
 #include "volume/error.h"
 #include "volume/lpv_calibration.h"
 #include "volume/mesh.h"
@@ -138,19 +139,36 @@ TEST(Propagation, CalibratedRetentionKeepsTheBalanceAndHoldsLightLonger) {
   EXPECT_GT(bareLeft.x, left.x * 1.05);
 }
 
-TEST(Propagation, RetentionCountsTheOutsideNeighbours) {
-  // A 4³ block of active cells: corners have 3 outside neighbours, edges 2, faces 1, the
-  // inner 2³ none.
-  const MaterialGrid m = uniformMaterial(6, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f, 0.25);
-  const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.5);
-  const float rho = calibratedTransport(1.0, 0.9, 0.0, 0.25, 1.5).retention;
-  ASSERT_GT(rho, 0.0f);
+TEST(Propagation, RetentionFollowsTheSurfaceAlongEachOutsideFace) {
+  // A 4³ block of active cells. A cell on a face (one outside neighbour, surface along the
+  // grid) keeps the aligned ρ. An edge cell's two outside faces see a surface of normal
+  // (1, 1, 0)/sqrt 2 whose plane passes the cell's outer edge, its centre d = sqrt 2 / 2
+  // cells deep: each face keeps 1 - |n_a| Δx / (d + z_b) (boundaryRetentionFromSurface);
+  // a corner's three faces likewise with n = (1, 1, 1)/sqrt 3, d = sqrt 3 / 2 cells. The
+  // inner 2³ keep nothing.
+  const double cellSize = 0.25, ior = 1.5;
+  const MaterialGrid m = uniformMaterial(6, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f, cellSize);
+  const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, ior);
+  const CellTransport t = calibratedTransport(1.0, 0.9, 0.0, cellSize, ior);
+  ASSERT_GT(t.retention, 0.0f);
+  const double zb = 2.0 * diffusionBoundaryCoefficient(ior) / (3.0 * 1.0);
+  const auto perFace = [&](double n) { return 1.0 - n * cellSize / (0.5 / n * cellSize + zb); };
+  const double edgeFace = perFace(std::sqrt(0.5)), cornerFace = perFace(std::sqrt(1.0 / 3.0));
+  EXPECT_NEAR(perFace(1.0), t.retention, 1e-6);  // the aligned rule is the same formula
   for (int z = 1; z <= 4; ++z)
     for (int y = 1; y <= 4; ++y)
       for (int x = 1; x <= 4; ++x) {
         const int outside = (x == 1 || x == 4) + (y == 1 || y == 4) + (z == 1 || z == 4);
-        for (int ch = 0; ch < 3; ++ch)
-          ASSERT_FLOAT_EQ(f.retention[ch][m.frame.index(x, y, z)], float(outside) * rho) << x << y << z;
+        const float kept = f.retention[0][m.frame.index(x, y, z)];
+        if (outside == 0) {
+          EXPECT_EQ(kept, 0.0f) << x << y << z;
+        } else if (outside == 1) {
+          EXPECT_NEAR(kept, t.retention, 1e-4) << x << y << z;  // d by bisection on the coverage
+        } else if (outside == 2) {
+          EXPECT_NEAR(kept, 2.0 * edgeFace, 1e-3) << x << y << z;
+        } else {
+          EXPECT_NEAR(kept, 3.0 * cornerFace, 1e-3) << x << y << z;
+        }
       }
   EXPECT_TRUE(computeStepFactors(m, LpvScheme::Seed, 1.5).retention[0].empty());
 }
@@ -298,16 +316,31 @@ TEST(GridFrame, TooLargeAGridIsAClearResourceError) {
 
 TEST(ExitGain, HomogeneousCellsKeepTheirCalibratedGain) {
   // Inside a homogeneous medium every neighbour has the same gain, so the neighbourhood
-  // limit changes nothing: the calibration (and its tests) stay exact.
+  // limit changes nothing: the calibration (and its tests) stay exact where the surface
+  // runs along the grid. Along the block's edges the surface's normal is diagonal, and the
+  // staircase correction (staircaseExitCorrection, |n|_1 = sqrt 2) applies on top.
   const MaterialGrid m = test::uniformMaterial(6, glm::vec3(3.0f, 5.0f, 9.0f), glm::vec3(1.0f, 1.0f, 1.0f), 0.2f, 0.7);
   const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.3);
+  int edges = 0;
   for (int ch = 0; ch < 3; ++ch) {
-    const float own = calibratedTransport(m.sigmaT[0][ch], m.sigmaS[0][ch], m.g[0], 0.7, 1.3).exitGain;
-    for (std::size_t i = 0; i < f.exitGain[ch].size(); ++i) {
-      if (!f.active[i]) continue;
-      ASSERT_EQ(f.exitGain[ch][i], own) << "cell " << i << " channel " << ch;
-    }
+    const CellTransport own = calibratedTransport(m.sigmaT[0][ch], m.sigmaS[0][ch], m.g[0], 0.7, 1.3);
+    ASSERT_GT(own.freshShare, 0.0f);  // else the edge check below would be vacuous
+    for (int z = 1; z <= 4; ++z)
+      for (int y = 1; y <= 4; ++y)
+        for (int x = 1; x <= 4; ++x) {
+          const std::size_t i = m.frame.index(x, y, z);
+          const int outside = (x == 1 || x == 4) + (y == 1 || y == 4) + (z == 1 || z == 4);
+          if (outside <= 1) {
+            ASSERT_EQ(f.exitGain[ch][i], own.exitGain) << "cell " << x << y << z << " channel " << ch;
+          } else if (outside == 2) {
+            EXPECT_NEAR(f.exitGain[ch][i], own.exitGain * staircaseExitCorrection(own.freshShare, std::sqrt(2.0)),
+                        1e-5 * own.exitGain)
+                << "cell " << x << y << z << " channel " << ch;
+            ++edges;
+          }
+        }
   }
+  EXPECT_EQ(edges, 3 * 24);
 }
 
 // A dense, less scattering spot painted into a thin, bright medium (cells 0.2 mm): the

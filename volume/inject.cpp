@@ -82,6 +82,7 @@ struct Placement {
   std::size_t deepCells[3][8];
   float deepWeights[3][8];
   int deepUsed[3] = {0, 0, 0};
+  float gain[3] = {1.0f, 1.0f, 1.0f};  ///< the oblique-entry gain per channel
 };
 
 void place(const SurfaceFluxSample& s, const MaterialGrid& material, const StepFactors* calibrated,
@@ -92,9 +93,13 @@ void place(const SurfaceFluxSample& s, const MaterialGrid& material, const StepF
   if (out.used == 0 || calibrated == nullptr) return;
   const std::size_t surfaceCell = depthCell(out.cells, out.weights, out.used);
   // The refracted beam first scatters about injectionDepth along its path, which is
-  // shallower when it enters obliquely (more of it comes back out, as in the medium).
+  // shallower when it enters obliquely (more of it comes back out, as in the medium; the
+  // oblique-entry gain makes how much more exact for a thick slab).
   const double cosRefracted = std::max(0.0, -glm::dot(glm::dvec3(s.direction), n));
+  const double incidence = incidentCosineSquared(cosRefracted, calibrated->ior);
   for (int ch = 0; ch < 3; ++ch) {
+    out.gain[ch] = float(
+        obliqueEntryGain(&calibrated->obliqueGain[ch][surfaceCell * std::size_t(kObliqueIntervals)], incidence));
     const double depth = std::max(halfCell, double(calibrated->injectionDepth[ch][surfaceCell]) * cosRefracted);
     int& used = out.deepUsed[ch];
     used = depth == halfCell ? 0 : cellsAtDepth(material, p, n, depth, out.deepCells[ch], out.deepWeights[ch]);
@@ -134,7 +139,7 @@ InjectionStats injectSamples(const std::vector<SurfaceFluxSample>& samples, cons
           addToCells(grid, ch, sh::cosineLobe(s.direction, s.flux[ch] / sh::kPi), at.cells, at.weights, at.used);
         } else {
           // Isotropic with power Φ: the c0 of a cosine lobe of power Φ, no linear band.
-          const sh::Coeffs isotropic(sh::kLobeC0 * s.flux[ch] / sh::kPi, 0.0f, 0.0f, 0.0f);
+          const sh::Coeffs isotropic(sh::kLobeC0 * at.gain[ch] * s.flux[ch] / sh::kPi, 0.0f, 0.0f, 0.0f);
           addToCells(grid, ch, isotropic, at.deepCells[ch], at.deepWeights[ch], at.deepUsed[ch]);
         }
       }

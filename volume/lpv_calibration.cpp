@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -49,7 +50,34 @@ struct BoundaryTable {
   double entering = 1.0;  ///< 1 - F(0): the injection's share of normal irradiance
   double leaving = 1.0;   ///< diffuseBoundaryTransmittance(ior): the shading's exit share
   double extrapolation = 2.0 / 3.0;  ///< z_b σt' = 2 A / 3 (diffusionBoundaryCoefficient)
+  /// Per oblique node k = 1 .. kObliqueIntervals (y = 1 - k / kObliqueIntervals), over
+  /// t = i / kObliqueAlbedoIntervals: the medium's diffuse reflectance per entering power
+  /// at that incidence relative to normal incidence.
+  std::array<std::vector<double>, kObliqueIntervals> obliqueRatio;
 };
+
+/// The oblique ratio varies slowly with the albedo, so 16 intervals (cubic) reproduce
+/// adding-doubling to 1e-5 (lpv_calibration_test) and the table costs ~40 ms per ior.
+constexpr int kObliqueAlbedoIntervals = 16;
+
+/// cos² θi at which a node is evaluated: the grazing node (y = 0) lets no power in, so it
+/// holds the value at cos θi = 0.03; for η < 1, light arriving flatter than the critical
+/// angle outside is totally reflected, so such nodes hold the flattest that enters.
+double obliqueNodeCosineSquared(int k, double ior) {
+  constexpr double kGrazing = 0.03 * 0.03;
+  const double y = 1.0 - double(k) / kObliqueIntervals;
+  return std::max({y, kGrazing, 1.0 - ior * ior + kGrazing});
+}
+
+/// cos θt inside for light arriving at cos² θi = y outside.
+double refractedCosine(double y, double ior) { return std::sqrt(std::max(0.0, 1.0 - (1.0 - y) / (ior * ior))); }
+
+/// Diffusely reflected power per entering power of a beam entering at cos² θi = y.
+double reflectancePerEntering(double albedo, double ior, double y) {
+  AddingDoublingOptions options;
+  options.beamCosine = refractedCosine(y, ior);
+  return addingDoublingHalfSpace(albedo, ior, options).rd / (1.0 - fresnelReflectance(std::sqrt(y), ior));
+}
 
 std::unique_ptr<const BoundaryTable> buildBoundaryTable(double ior) {
   auto table = std::make_unique<BoundaryTable>();
@@ -63,6 +91,18 @@ std::unique_ptr<const BoundaryTable> buildBoundaryTable(double ior) {
     const double albedo = i == 0 ? 1.0 : std::max(1e-9, 1.0 - t * t);
     table->rdOverAlbedo[std::size_t(i)] =
         i == 0 ? 1.0 - fresnelReflectance(1.0, ior) : addingDoublingHalfSpace(albedo, ior).rd / albedo;
+  }
+  for (int k = 1; k <= kObliqueIntervals; ++k) {
+    std::vector<double>& ratio = table->obliqueRatio[std::size_t(k - 1)];
+    ratio.resize(kObliqueAlbedoIntervals + 1);
+    const double y = obliqueNodeCosineSquared(k, ior);
+    // t = 0: a non-absorbing half-space returns all that enters, at any angle.
+    ratio[0] = 1.0;
+    for (int i = 1; i <= kObliqueAlbedoIntervals; ++i) {
+      const double t = double(i) / kObliqueAlbedoIntervals;
+      const double albedo = std::max(1e-9, 1.0 - t * t);
+      ratio[std::size_t(i)] = reflectancePerEntering(albedo, ior, y) / reflectancePerEntering(albedo, ior, 1.0);
+    }
   }
   table->entering = 1.0 - fresnelReflectance(1.0, ior);
   table->leaving = diffuseBoundaryTransmittance(ior);
@@ -157,12 +197,33 @@ double boundaryReflectance(double albedo, double ior) {
 
 double halfSpaceReflectance(double albedo) { return boundaryReflectance(albedo, 1.0); }
 
+double incidentCosineSquared(double cosRefracted, double ior) {
+  return std::clamp(1.0 - ior * ior * (1.0 - cosRefracted * cosRefracted), 0.0, 1.0);
+}
+
+double staircaseExitCorrection(double freshShare, double normalL1) {
+  const double f = std::clamp(freshShare, 0.0, 1.0);
+  return 1.0 / (1.0 - f + f / std::clamp(normalL1, 1.0, std::sqrt(3.0)));
+}
+
+double obliqueEntryGain(const float* nodes, double y) {
+  // Node k sits at y = 1 - k / kObliqueIntervals; y = 1 (k = 0) has gain 1.
+  const double x = std::clamp((1.0 - y) * kObliqueIntervals, 0.0, double(kObliqueIntervals));
+  const int k = std::min(int(x), kObliqueIntervals - 1);
+  const double below = k == 0 ? 1.0 : double(nodes[k - 1]), above = double(nodes[k]);
+  return below + (x - k) * (above - below);
+}
+
 CellTransport seedTransport(double sigmaT, double sigmaS, double g, double cellSize) {
   const double e = std::exp(-sigmaT * cellSize);
   // Albedo of an empty cell is irrelevant (e = 1); guard the 0/0.
   const double albedo = sigmaT > 0.0 ? std::min(1.0, sigmaS / sigmaT) : 1.0;
   const double scattered = albedo * (1.0 - e);
-  return {float(e + scattered), float(e + scattered * g), 1.0f};
+  CellTransport t;
+  t.dc = float(e + scattered);
+  t.linear = float(e + scattered * g);
+  t.obliqueGain.fill(1.0f);
+  return t;
 }
 
 CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double cellSize, double ior) {
@@ -180,11 +241,15 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   const double retention =
       reducedT > 0.0 ? boundaryRetention(boundary.extrapolation / reducedT, cellSize) : kMaxRetention;
   const double injectionDepth = reducedT > 0.0 ? 1.0 / reducedT : 0.0;
-  const double layer = std::max(injectionDepth, 0.5 * cellSize) / cellSize + 0.5;
-  const double first = std::floor(layer), deeper = layer - first;
-  const double latticeReflectance = survival > 0.0 ? 3.0 * std::pow(r, first) * (1.0 - deeper + deeper * r) /
-                                                         (survival * (1.0 - retention * r))
-                                                   : 0.0;
+  // R_lpv of light injected `depth` deep (the derivation at the top of this file).
+  const auto layerOf = [&](double depth) { return std::max(depth, 0.5 * cellSize) / cellSize + 0.5; };
+  const auto latticeReflectanceAt = [&](double depth) {
+    if (!(survival > 0.0)) return 0.0;
+    const double layer = layerOf(depth);
+    const double first = std::floor(layer), deeper = layer - first;
+    return 3.0 * std::pow(r, first) * (1.0 - deeper + deeper * r) / (survival * (1.0 - retention * r));
+  };
+  const double latticeReflectance = latticeReflectanceAt(injectionDepth);
   // The injection has already taken 1 - F(0) of the irradiance and the shading lets out
   // `leaving` of an isotropic cell's power, so this gain makes the lattice reflect the
   // medium's Rd in total.
@@ -197,7 +262,25 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   t.exitGain = float(gain);
   t.reducedAlbedo = float(reducedAlbedo);
   t.retention = float(retention);
+  t.extrapolationLength =
+      reducedT > 0.0 ? float(boundary.extrapolation / reducedT) : std::numeric_limits<float>::infinity();
   t.injectionDepth = float(injectionDepth);
+  // The light injected into layer 1 (the floor, m* = 1) against all that layer holds.
+  if (survival > 0.0) {
+    const double layer = layerOf(injectionDepth);
+    const double injectedInFirst = std::floor(layer) == 1.0 ? 2.0 - layer : 0.0;
+    const double heldInFirst = 2.0 * latticeReflectance;  // w(1) = 2 R_lpv
+    t.freshShare = heldInFirst > 0.0 ? float(std::min(1.0, injectedInFirst / heldInFirst)) : 0.0f;
+  }
+  const double t01 = std::sqrt(1.0 - std::clamp(reducedAlbedo, 0.0, 1.0));
+  for (int k = 1; k <= kObliqueIntervals; ++k) {
+    const double y = obliqueNodeCosineSquared(k, ior);
+    const double medium = interpolateCubic(boundary.obliqueRatio[std::size_t(k - 1)], t01);
+    const double lattice = latticeReflectanceAt(injectionDepth * refractedCosine(y, ior));
+    double nodeGain = lattice > 0.0 ? medium * latticeReflectance / lattice : 1.0;
+    if (!std::isfinite(nodeGain) || !(nodeGain > 0.0)) nodeGain = 1.0;
+    t.obliqueGain[std::size_t(k - 1)] = float(nodeGain);
+  }
   return t;
 }
 

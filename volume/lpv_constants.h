@@ -42,4 +42,10 @@
 #define SSLPV_EXIT_LAW_ALBEDO_INTERVALS 32
 #define SSLPV_EXIT_LAW_MU_INTERVALS 64
 
+// The calibrated injection's oblique-entry gain (volume/lpv_calibration.h): per cell and
+// channel, its values at y = 1 - k / OBLIQUE_INTERVALS, k = 1 .. OBLIQUE_INTERVALS, where
+// y = cos^2 of the outside incidence angle (1 at normal incidence, where the gain is 1),
+// piecewise linear in y.
+#define SSLPV_OBLIQUE_INTERVALS 4
+
 #endif

@@ -50,17 +50,19 @@ int activeTrilinearWeights(const MaterialGrid& material, const glm::dvec3& p,
 struct StepFactors;
 
 struct InjectionStats {
-  glm::dvec3 injectedFlux{0.0};  ///< total flux written into the grid
+  /// Total flux of the samples written into the grid (before the calibrated scheme's
+  /// oblique-entry gain, which like the exit gain is a coupling factor, not light lost).
+  glm::dvec3 injectedFlux{0.0};
   glm::dvec3 droppedFlux{0.0};   ///< flux of samples with no active cell nearby
 };
 
 /// Seed scheme (`calibrated` null): adds each sample as a clamped cosine lobe about its
 /// refracted direction, holding flux/π, half a cell inside the surface, spread
 /// trilinearly over active cells. Calibrated scheme (`calibrated` holds its step factors):
-/// per channel, an isotropic source of the sample's flux at depth
-/// max(injectionDepth cos θt, Δx / 2) along the inward normal, injectionDepth read from
-/// the cell half a cell inside (lpv_calibration.h), θt the refracted direction's angle to
-/// the normal. Either way a sample that finds no active cell
+/// per channel, an isotropic source of the sample's flux times the oblique-entry gain at
+/// depth max(injectionDepth cos θt, Δx / 2) along the inward normal, injectionDepth and
+/// the gain's nodes read from the cell half a cell inside (lpv_calibration.h), θt the
+/// refracted direction's angle to the normal. Either way a sample that finds no active cell
 /// there looks a cell deeper (Δx / 2 further) before it is dropped.
 InjectionStats injectSamples(const std::vector<SurfaceFluxSample>& samples,
                              const MaterialGrid& material, ShGrid& grid,
@@ -120,6 +122,12 @@ struct StepFactors {
   /// Calibrated scheme: per channel, per cell, CellTransport::injectionDepth (scene
   /// units). Empty in the seed scheme.
   std::array<std::vector<float>, 3> injectionDepth;
+  /// Calibrated scheme: per channel, per cell, kObliqueIntervals consecutive values of
+  /// CellTransport::obliqueGain. Empty in the seed scheme.
+  std::array<std::vector<float>, 3> obliqueGain;
+  /// The boundary's relative index, which turns a sample's refracted direction back into
+  /// its incidence angle for the oblique-entry gain (incidentCosineSquared).
+  double ior = 1.0;
   std::vector<unsigned char> active;  ///< coverage > 0 and not on the outer ring
   /// Per (y, z) row: does it hold any active cell? Rows without one never hold light and
   /// are skipped, so cost follows the object's cells rather than its bounding box.

@@ -1,0 +1,83 @@
+// A slab whose surface is not aligned with the grid: its boundary is a staircase of cells.
+// The calibrated scheme's boundary retention is derived for a face along the grid axes
+// (volume/lpv_calibration.h); computeStepFactors re-derives it for tilted surfaces so that
+// the lattice's diffuse profile vanishes at the same extrapolation length beyond the true
+// surface. These tests render the same slab, lit and seen along its normal, aligned with
+// the grid and tilted, and compare the two SSLPV renders (the aligned one matches the path
+// tracer to 0.1 %, README "Calibration"). Light injected at the half-cell floor and read
+// back before it propagates is diluted over a staircase's cells; computeStepFactors also
+// corrects the exit gain for that (staircaseExitCorrection).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "volume/cpu_renderer.h"
+#include "volume/scene.h"
+
+namespace {
+using namespace sslpv;
+
+/// A slab 30 x 15 x 30 mm, top face through the origin, rotated by `rotateDeg` (scene
+/// order: z, then y, then x), lit by a directional light against its top face's normal and
+/// seen along it; the camera sees only the central 5 mm of the top face.
+Scene tiltedSlab(const std::string& preset, double ior, const glm::dvec3& rotateDeg, double extraDepth = 0.0) {
+  const glm::dmat4 rotation = Transform{glm::dvec3(0.0), rotateDeg, 1.0}.matrix();
+  const glm::dvec3 normal = glm::normalize(glm::dvec3(rotation * glm::dvec4(0, 1, 0, 0)));
+  const glm::dvec3 up = glm::normalize(glm::dvec3(rotation * glm::dvec4(0, 0, 1, 0)));
+  auto vec = [](const glm::dvec3& v) {
+    return "[" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + "]";
+  };
+  const std::string json = R"({"units": "mm", "mesh": {"primitive": "box", "min": [-15, )" + std::to_string(-15.0 - extraDepth) + R"(, -15], "max": [15, 0, 15]},
+    "transform": {"rotate_deg": )" + vec(rotateDeg) + R"(},
+    "material": {"base": {"preset": ")" + preset + R"("}, "ior": )" + std::to_string(ior) + R"(},
+    "lights": [{"type": "directional", "direction": )" + vec(-normal) + R"(, "irradiance": [1, 1, 1]}],
+    "camera": {"position": )" + vec(200.0 * normal) + R"(, "target": [0, 0, 0], "up": )" + vec(up) + R"(,
+               "fov_y_deg": 1.5, "width": 24, "height": 24},
+    "lpv": {"resolution": 32, "steps": "auto", "shadow_map": 128}})";
+  return parseScene(json, "tilted_slab.json");
+}
+
+glm::dvec3 meanRadiance(const Scene& scene) {
+  const Image image = CpuRenderer(scene).render(scene.lpv);
+  glm::dvec3 sum(0.0);
+  for (const glm::vec3& p : image.pixels) sum += glm::dvec3(p);
+  return sum / double(image.pixels.size());
+}
+
+// The same slab tilted by 30° and 45° about one axis, against the aligned slab. Where a
+// face falls within its cells depends on the grid's phase, and that moves the result by
+// up to 30 % (README "Accuracy": the aligned slab itself, off its calibrated phase), so the
+// tilted slab is averaged over three phases (the slab 0, 0.4 and 0.8 mm deeper, which
+// shifts the grid that follows its bounds) and compared with the aligned slab in its
+// calibrated phase (top face on a cell face, where it matches the path tracer to 0.1 %).
+// Before the staircase model (one flat ρ on every face of the staircase, no correction of
+// unpropagated light): ketchup red x0.92 / x0.90, its blue x0.83 / x0.85, marble x1.10.
+// Measured now (30° / 45°, R G B): ketchup 0.96 1.00 0.95 / 0.97 1.01 0.93, marble
+// 1.02 1.08 1.11 / 1.01 1.05 1.07, skin 1.00 0.96 0.91 / 1.01 0.96 0.90. The red
+// channels, diffusion-dominated, must stay within 4 %; the others, where the
+// unpropagated share and marble's partly covered cells leave ~10 %, within 12 %.
+TEST(TiltedBoundary, ChannelsReflectAsTheAlignedSlabOverGridPhases) {
+  struct Case {
+    const char* preset;
+    double ior;
+  };
+  for (const Case& c : {Case{"ketchup", 1.3}, Case{"marble", 1.5}, Case{"skin1", 1.4}}) {
+    const glm::dvec3 aligned = meanRadiance(tiltedSlab(c.preset, c.ior, glm::dvec3(0.0)));
+    for (double tilt : {30.0, 45.0}) {
+      glm::dvec3 tilted(0.0);
+      for (double extra : {0.0, 0.4, 0.8})
+        tilted += meanRadiance(tiltedSlab(c.preset, c.ior, glm::dvec3(0.0, 0.0, tilt), extra)) / 3.0;
+      std::printf("[ measured ] %s tilted %.0f: %.3f %.3f %.3f of the aligned slab\n", c.preset, tilt,
+                  tilted.x / aligned.x, tilted.y / aligned.y, tilted.z / aligned.z);
+      for (int ch = 0; ch < 3; ++ch) {
+        ASSERT_GT(aligned[ch], 0.0) << c.preset;
+        const double tolerance = ch == 0 ? 0.04 : 0.12;
+        EXPECT_NEAR(tilted[ch] / aligned[ch], 1.0, tolerance) << c.preset << " channel " << ch << " tilted " << tilt;
+      }
+    }
+  }
+}
+
+}  // namespace
