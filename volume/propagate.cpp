@@ -241,11 +241,24 @@ void limitExitGainToNeighbours(const MaterialGrid& material, StepFactors& factor
   }
 }
 
+/// The coverage gradient over a cell's 3x3x3 neighbourhood (its direction points into the
+/// object): over a staircase of partly covered cells it follows the surface's plane rather
+/// than the axis of the nearest step. Active cells never touch the grid's edge, so the
+/// neighbours exist.
+glm::dvec3 coverageGradient(const MaterialGrid& material, int x, int y, int z) {
+  const GridFrame& f = material.frame;
+  glm::dvec3 gradient(0.0);
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        gradient += double(material.coverage[f.index(x + dx, y + dy, z + dz)]) * glm::dvec3(dx, dy, dz);
+  return gradient;
+}
+
 /// Multiplies each boundary cell's exit gain by staircaseExitCorrection for its surface
-/// normal: the direction of the coverage gradient (3x3x3 Sobel, so that a staircase of
-/// partial cells gives the plane's normal rather than the axis of its nearest step).
-/// Cells with no coverage change around them (interior, or an aligned face's flat side
-/// along which the gradient is axial) get |n|_1 = 1 and keep their gain.
+/// normal, the direction of coverageGradient. Cells with no coverage change around them
+/// (interior, or an aligned face's flat side along which the gradient is axial) get
+/// |n|_1 = 1 and keep their gain.
 void correctStaircaseExit(const MaterialGrid& material, const std::array<std::vector<float>, 3>& freshShare,
                           StepFactors& factors) {
   const GridFrame& f = material.frame;
@@ -254,18 +267,7 @@ void correctStaircaseExit(const MaterialGrid& material, const std::array<std::ve
       for (int x = 0; x < f.dims.x; ++x) {
         const std::size_t i = f.index(x, y, z);
         if (!factors.active[i]) continue;
-        glm::dvec3 gradient(0.0);
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              // Active cells never touch the grid's edge, so the neighbours exist.
-              const double c = material.coverage[f.index(x + dx, y + dy, z + dz)];
-              const glm::dvec3 offset(dx, dy, dz);
-              // Sobel: central difference along one axis, smoothed 1-2-1 across the others.
-              const glm::dvec3 smooth((2 - std::abs(dy)) * (2 - std::abs(dz)), (2 - std::abs(dx)) * (2 - std::abs(dz)),
-                                      (2 - std::abs(dx)) * (2 - std::abs(dy)));
-              gradient += c * offset * smooth;
-            }
+        const glm::dvec3 gradient = coverageGradient(material, x, y, z);
         const double length = glm::length(gradient);
         if (!(length > 1e-6)) continue;
         const double normalL1 = (std::abs(gradient.x) + std::abs(gradient.y) + std::abs(gradient.z)) / length;
@@ -331,11 +333,7 @@ void boundaryRetentionFromSurface(const MaterialGrid& material, const std::array
           }
         for (int ch = 0; ch < 3; ++ch) factors.retention[ch][i] = 0.0f;
         if (outsideAlong == glm::ivec3(0)) continue;
-        glm::dvec3 gradient(0.0);
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dxi = -1; dxi <= 1; ++dxi)
-              gradient += double(material.coverage[f.index(x + dxi, y + dy, z + dz)]) * glm::dvec3(dxi, dy, dz);
+        const glm::dvec3 gradient = coverageGradient(material, x, y, z);
         // No gradient (a cell alone or in a one-cell sliver): the faces it has outside.
         const glm::dvec3 normal = glm::length(gradient) > 0.0 ? glm::abs(glm::normalize(gradient))
                                                              : glm::normalize(glm::dvec3(outsideAlong));
