@@ -167,7 +167,7 @@ double boundaryRetention(double extrapolationLength, double cellSize);
 double boundaryReflectance(double albedo, double ior);
 
 /// Builds the per-ior tables the calibrated scheme uses (boundaryReflectance, the exit law
-/// and the oblique-entry ratios, ~75 ms together) now, so renderers pay it while loading
+/// and the oblique-entry ratios, ~60 ms together) now, so renderers pay it while loading
 /// the object rather than inside their first frame's stage timings. Throws like boundaryReflectance.
 void prepareCalibrationTables(double ior);
 
