@@ -65,8 +65,9 @@ void printTable(const CompareArgs& args, const Image& a, const ImageMetrics& m) 
   std::printf("RMSE           %.6g\n", m.rmse);
   std::printf("relative MSE   %.6g   ((A-B)^2 / (B^2 + eps), eps = (0.01 mean B)^2 = %.3g)\n", m.relativeMse,
               m.relativeMseEpsilon);
-  std::printf("mean rel. err  %.6g   (|A-B| / max(|B|, 0.01 mean B = %.3g))\n", m.meanRelativeError,
-              m.relativeFloor);
+  std::printf("mean rel. err  %.6g   (|A-B| / max(|B|, 0.01 mean B = %.3g); RGB %.4g %.4g %.4g)\n",
+              m.meanRelativeError, m.relativeFloor, m.meanRelativeErrorRgb.r, m.meanRelativeErrorRgb.g,
+              m.meanRelativeErrorRgb.b);
   std::printf("SSIM           %.6g   (luminance, Gaussian 11x11 sigma 1.5, L = max B luminance = %.6g)\n", m.ssim,
               m.ssimRange);
 }
@@ -86,12 +87,20 @@ CLI::App* addCompareCommand(CLI::App& app, CompareArgs& args) {
                   "Average KxK blocks first (a block is in the mask when all its pixels are) to "
                   "suppress reference noise");
   cmd->add_option("--json", args.json, "Also write the numbers to this JSON file (atomically)");
+  cmd->add_option("--ratio-map", args.ratioMap,
+                  "Also write where A and B differ (.png/.exr/.pfm): R, G, B panels, white where equal, "
+                  "red where A is brighter, blue where darker, full colour at x2 / x1/2; per block with --block");
   return cmd;
 }
 
 int runCompare(const CompareArgs& args) {
   if (args.block < 1) throw InputError("--block: must be at least 1, got " + std::to_string(args.block));
   if (!args.json.empty()) requireWritableOutput(args.json);
+  if (!args.ratioMap.empty()) {
+    if (!isSupportedImageExtension(args.ratioMap))
+      throw InputError(args.ratioMap + ": --ratio-map must end in .png, .exr or .pfm");
+    requireWritableOutput(args.ratioMap);
+  }
 
   const Image a = readLinearImage(args.a, "A");
   requireFinite(a, args.a);
@@ -154,6 +163,8 @@ int runCompare(const CompareArgs& args) {
       if (!out) throw InputError(args.json + ": write failed");
     });
   }
+  if (!args.ratioMap.empty())
+    writeImage(ratioMap(blockA, blockB, mask, metrics.relativeFloor, args.block), args.ratioMap);
   printTable(args, a, metrics);
   return 0;
 }

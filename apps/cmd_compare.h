@@ -12,6 +12,7 @@ struct CompareArgs {
   std::string mask = "auto";    ///< "auto" (non-zero in A or B) or a mask image (value > 0)
   int block = 1;                ///< average K×K blocks first
   std::string json;             ///< optional JSON record, written atomically
+  std::string ratioMap;         ///< optional per-channel map of A / B (ratioMap), written atomically
 };
 
 CLI::App* addCompareCommand(CLI::App& app, CompareArgs& args);

@@ -257,6 +257,35 @@ TEST_F(CompareCli, RejectsAReferenceThatIsZeroOverTheObject) {
   expectRejected({pa, pb}, {"b.exr", "positive"});
 }
 
+TEST_F(CompareCli, RatioMapShowsWhereEachChannelDiffers) {
+  // The object [8, 28)² is 10 % bright in green only; with 4×4 blocks the map holds three
+  // 36-pixel-wide panels of whole blocks (36 / 4 = 9 blocks, drawn 4×4 each). Inside the
+  // object red and blue are white, green is pink (log2 1.1 of the way to red), and the
+  // background is black.
+  const std::string b = write("b.exr", squareImage(8, 28, glm::vec3(1.0f)));
+  const std::string a = write("a.exr", squareImage(8, 28, glm::vec3(1.0f, 1.1f, 1.0f)));
+  const std::string mapPath = file("map.exr");
+  const RunResult r = run({a, b, "--block", "4", "--ratio-map", mapPath});
+  ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  EXPECT_NE(r.stdoutText.find("RGB 0 0.1 0"), std::string::npos) << "per-channel errors in\n" << r.stdoutText;
+  const Image map = readImage(mapPath);
+  ASSERT_EQ(map.width, 3 * 36);
+  ASSERT_EQ(map.height, 36);
+  const float pink = 1.0f - float(std::log2(1.1f / 1.0f));
+  EXPECT_EQ(map.at(16, 16), glm::vec3(1.0f));
+  EXPECT_EQ(map.at(2 * 36 + 16, 16), glm::vec3(1.0f));
+  EXPECT_NEAR(map.at(36 + 16, 16).r, 1.0f, 1e-6f);
+  EXPECT_NEAR(map.at(36 + 16, 16).g, pink, 1e-4f);
+  EXPECT_NEAR(map.at(36 + 16, 16).b, pink, 1e-4f);
+  EXPECT_EQ(map.at(2, 2), glm::vec3(0.0f));
+}
+
+TEST_F(CompareCli, RejectsARatioMapItCannotWriteBeforeReading) {
+  const std::string pa = write("a.exr", squareImage(8, 28, glm::vec3(1.0f)));
+  expectRejected({pa, pa, "--ratio-map", file("map.txt")}, {"map.txt", ".png"});
+  expectRejected({pa, pa, "--ratio-map", (dir_ / "no_such_dir" / "map.png").string()}, {"no_such_dir"});
+}
+
 TEST_F(CompareCli, RejectsAnUnwritableJsonPathBeforeReading) {
   const std::string pa = write("a.exr", squareImage(8, 28, glm::vec3(1.0f)));
   filesBefore_ = listing();

@@ -73,6 +73,50 @@ TEST(ImageMetrics, TenPercentGainGivesExactRelativeErrors) {
   EXPECT_NEAR(m.meanRatio, 1.1, 1e-6);
 }
 
+TEST(ImageMetrics, PerChannelRelativeErrorsAverageToTheMetric) {
+  // Only green is 20 % bright and only blue 10 % dark: the channels' errors are exactly
+  // those, red none, and the overall metric is their mean.
+  const glm::vec3 bValue(2.0f, 3.0f, 4.0f);
+  const Image b = constantImage(6, 5, bValue);
+  const Image a = constantImage(6, 5, glm::vec3(2.0f, 3.6f, 3.6f));
+  const ImageMetrics m = computeImageMetrics(a, b, fullMask(6, 5));
+  EXPECT_EQ(m.meanRelativeErrorRgb.r, 0.0);
+  EXPECT_NEAR(m.meanRelativeErrorRgb.g, 0.2, 1e-6);
+  EXPECT_NEAR(m.meanRelativeErrorRgb.b, 0.1, 1e-6);
+  EXPECT_NEAR(m.meanRelativeError, 0.1, 1e-6);
+}
+
+TEST(ImageMetrics, RatioMapColoursEachChannelByItsRatio) {
+  // 2 x 1 pixels: the left one A = B in red, twice B in green, half B in blue; the right
+  // one outside the mask. Panels R, G, B side by side, each pixel drawn 2 x 2.
+  Image b = constantImage(2, 1, glm::vec3(1.0f));
+  Image a = b;
+  a.at(0, 0) = glm::vec3(1.0f, 2.0f, 0.5f);
+  PixelMask mask(2, 1);
+  mask.set(0, 0, true);
+  const Image map = ratioMap(a, b, mask, 0.01, 2);
+  ASSERT_EQ(map.width, 3 * 2 * 2);
+  ASSERT_EQ(map.height, 2);
+  const glm::vec3 white(1.0f), red(1.0f, 0.0f, 0.0f), blue(0.0f, 0.0f, 1.0f), black(0.0f);
+  for (int dy = 0; dy < 2; ++dy)
+    for (int dx = 0; dx < 2; ++dx) {
+      EXPECT_EQ(map.at(dx, dy), white);      // red panel: equal
+      EXPECT_EQ(map.at(4 + dx, dy), red);    // green panel: x2, full red
+      EXPECT_EQ(map.at(8 + dx, dy), blue);   // blue panel: x1/2, full blue
+      EXPECT_EQ(map.at(2 + dx, dy), black);  // outside the mask
+    }
+  // x sqrt(2) is half way to red; both under the floor is grey, not "equal".
+  a.at(0, 0) = glm::vec3(std::sqrt(2.0f), 0.001f, 0.002f);
+  b.at(0, 0) = glm::vec3(1.0f, 0.002f, 0.001f);
+  const Image second = ratioMap(a, b, mask, 0.01, 1);
+  EXPECT_NEAR(second.at(0, 0).g, 0.5f, 1e-6f);
+  EXPECT_EQ(second.at(0, 0).r, 1.0f);
+  EXPECT_EQ(second.at(2, 0), glm::vec3(kRatioMapBelowFloor));
+  EXPECT_EQ(second.at(4, 0), glm::vec3(kRatioMapBelowFloor));
+  EXPECT_THROW(ratioMap(a, rampImage(3, 1), mask, 0.01, 1), std::invalid_argument);
+  EXPECT_THROW(ratioMap(a, b, mask, 0.0, 1), std::invalid_argument);
+}
+
 TEST(ImageMetrics, ConstantOffsetGivesThatRmse) {
   const Image b = rampImage(16, 16);
   Image a = b;
@@ -283,7 +327,8 @@ TEST(ImageMetrics, JsonRecordHoldsEveryNumber) {
   const ImageMetrics m = computeImageMetrics(a, b, fullMask(2, 2));
   const std::string text = compareJson({"a.exr", "b.exr", "auto", 4, 4, 2}, m);
   for (const char* key : {"\"a\"", "\"b\"", "\"mask\"", "\"block\"", "\"mask_pixels\"", "\"mean_ratio\"",
-                          "\"rmse\"", "\"relative_mse\"", "\"mean_relative_error\"", "\"ssim\"", "\"ssim_range\""})
+                          "\"rmse\"", "\"relative_mse\"", "\"mean_relative_error\"",
+                          "\"mean_relative_error_rgb\"", "\"ssim\"", "\"ssim_range\""})
     EXPECT_NE(text.find(key), std::string::npos) << key;
   EXPECT_EQ(text.back(), '\n');
 }

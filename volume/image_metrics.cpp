@@ -210,7 +210,8 @@ ImageMetrics computeImageMetrics(const Image& a, const Image& b, const PixelMask
   m.relativeFloor = kRelativeFloorFraction * m.meanB;
   m.relativeMseEpsilon = m.relativeFloor * m.relativeFloor;
 
-  double squared = 0.0, relativeSquared = 0.0, relative = 0.0;
+  double squared = 0.0, relativeSquared = 0.0;
+  glm::dvec3 relative(0.0);
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
     if (!mask.inside[i]) continue;
     for (int c = 0; c < 3; ++c) {
@@ -218,12 +219,13 @@ ImageMetrics computeImageMetrics(const Image& a, const Image& b, const PixelMask
       const double d = va - vb;
       squared += d * d;
       relativeSquared += d * d / (vb * vb + m.relativeMseEpsilon);
-      relative += std::abs(d) / std::max(std::abs(vb), m.relativeFloor);
+      relative[c] += std::abs(d) / std::max(std::abs(vb), m.relativeFloor);
     }
   }
   m.rmse = std::sqrt(squared / samples);
   m.relativeMse = relativeSquared / samples;
-  m.meanRelativeError = relative / samples;
+  m.meanRelativeErrorRgb = relative / pixels;
+  m.meanRelativeError = (relative.r + relative.g + relative.b) / samples;
   m.ssimRange = maxLuminanceB;
   m.ssim = ssim(a, b, mask, m.ssimRange);
   return m;
@@ -249,11 +251,36 @@ std::string compareJson(const CompareSource& source, const ImageMetrics& m) {
       {"relative_mse", m.relativeMse},
       {"relative_mse_epsilon", m.relativeMseEpsilon},
       {"mean_relative_error", m.meanRelativeError},
+      {"mean_relative_error_rgb", {m.meanRelativeErrorRgb.r, m.meanRelativeErrorRgb.g, m.meanRelativeErrorRgb.b}},
       {"relative_error_floor", m.relativeFloor},
       {"ssim", m.ssim},
       {"ssim_range", m.ssimRange},
   };
   return record.dump(2) + "\n";
+}
+
+Image ratioMap(const Image& a, const Image& b, const PixelMask& mask, double floor, int scale) {
+  if (a.width != b.width || a.height != b.height || mask.width != a.width || mask.height != a.height)
+    throw std::invalid_argument("ratioMap: A, B and the mask must have the same size");
+  if (scale < 1 || !(floor > 0.0)) throw std::invalid_argument("ratioMap: scale must be >= 1 and floor > 0");
+  Image map(3 * a.width * scale, a.height * scale);
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      if (!mask.at(x, y)) continue;
+      const glm::vec3 va = a.at(x, y), vb = b.at(x, y);
+      for (int c = 0; c < 3; ++c) {
+        // The metric's floor, so that noise in a near-black reference does not paint
+        // the map: below it both sides count as the floor.
+        const double ratio = std::max(double(va[c]), floor) / std::max(double(vb[c]), floor);
+        const float shade = float(std::min(1.0, std::abs(std::log2(ratio))));
+        glm::vec3 colour = ratio >= 1.0 ? glm::vec3(1.0f, 1.0f - shade, 1.0f - shade)
+                                        : glm::vec3(1.0f - shade, 1.0f - shade, 1.0f);
+        if (std::max(va[c], vb[c]) < floor) colour = glm::vec3(kRatioMapBelowFloor);
+        for (int dy = 0; dy < scale; ++dy)
+          for (int dx = 0; dx < scale; ++dx) map.at((c * a.width + x) * scale + dx, y * scale + dy) = colour;
+      }
+    }
+  return map;
 }
 
 double maxRelativeDifference(const Image& a, const Image& b) {

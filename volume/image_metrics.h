@@ -103,6 +103,7 @@ struct ImageMetrics {
   double rmse = 0;
   double relativeMse = 0, relativeMseEpsilon = 0;     ///< ε = (0.01 mean_B)²
   double meanRelativeError = 0, relativeFloor = 0;    ///< floor = 0.01 mean_B
+  glm::dvec3 meanRelativeErrorRgb{0.0};               ///< per channel (their mean is the above)
   double ssim = 0, ssimRange = 0;                     ///< L = max reference luminance
 };
 
@@ -110,6 +111,18 @@ struct ImageMetrics {
 /// callers that read files check them first to name the file): equal sizes, finite
 /// pixels, a non-empty mask, mean_B > 0 and a positive reference luminance in the mask.
 ImageMetrics computeImageMetrics(const Image& a, const Image& b, const PixelMask& mask);
+
+/// Where A and B disagree, per channel: three panels side by side (R, G, B), each pixel
+/// (or block) of the images drawn as scale × scale pixels, white where A = B, towards full
+/// red where A is brighter and full blue where it is darker, saturating at A / B = 2 and
+/// 1/2 (the colour's depth is |log2(A / B)|). Values under `floor` count as the floor (the
+/// relative metrics' floor, so reference noise in black regions does not paint the map);
+/// where A and B are both under it the pixel is grey (kRatioMapBelowFloor): too dark to
+/// compare relatively. Pixels outside the mask are black. Linear RGB in [0, 1], for
+/// writeImage as PNG.
+/// Preconditions (std::invalid_argument): equal sizes, scale ≥ 1, floor > 0.
+constexpr float kRatioMapBelowFloor = 0.25f;
+Image ratioMap(const Image& a, const Image& b, const PixelMask& mask, double floor, int scale);
 
 /// Where the numbers came from, for the JSON record.
 struct CompareSource {
