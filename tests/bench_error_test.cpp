@@ -179,6 +179,7 @@ std::vector<BenchRow> sampleRows() {
   rows[0].ms = {1.5, 2.25, 3, 4, 5, 6, 21.75};
   rows[0].metrics.relativeMse = 0.04;
   rows[0].metrics.meanRelativeError = 0.125;
+  rows[0].metrics.meanRelativeErrorRgb = glm::dvec3(0.25, 0.0625, 0.0625);
   rows[0].metrics.rmse = 0.5;
   rows[0].metrics.ssim = 0.875;
   rows[0].metrics.meanRatio = 1.0625;
@@ -197,8 +198,8 @@ TEST(BenchErrorTables, CsvHasTheDocumentedColumnsAndValues) {
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_EQ(rows[0],
             "scene,backend,scheme,grid,steps_requested,steps_run,shadow_map,voxelize_ms,resample_ms,shadow_map_ms,"
-            "injection_ms,propagation_ms,shading_ms,total_ms,relative_mse,mean_relative_error,rmse,ssim,mean_ratio,"
-            "pareto");
+            "injection_ms,propagation_ms,shading_ms,total_ms,relative_mse,mean_relative_error,"
+            "mean_relative_error_r,mean_relative_error_g,mean_relative_error_b,rmse,ssim,mean_ratio,pareto");
   const std::vector<std::string> a = splitCsvLine(rows[1]);
   const std::vector<std::string> b = splitCsvLine(rows[2]);
   ASSERT_EQ(a.size(), benchColumns().size());
@@ -206,14 +207,15 @@ TEST(BenchErrorTables, CsvHasTheDocumentedColumnsAndValues) {
   EXPECT_EQ(a[0], "examples/a,b.json");
   EXPECT_EQ(std::vector<std::string>(a.begin() + 1, a.end()),
             (std::vector<std::string>{"cpu", "seed", "32", "8", "8", "256", "1.500", "2.250", "3.000", "4.000",
-                                      "5.000", "6.000", "21.750", "0.04", "0.125", "0.5", "0.875", "1.0625", "1"}));
+                                      "5.000", "6.000", "21.750", "0.04", "0.125", "0.25", "0.0625", "0.0625", "0.5",
+                                      "0.875", "1.0625", "1"}));
   EXPECT_EQ(b[1], "vulkan");
   EXPECT_EQ(b[2], "calibrated");
   EXPECT_EQ(b[4], "auto");
   EXPECT_EQ(b[5], "230");
   EXPECT_EQ(b[6], "512");
-  EXPECT_EQ(b[17], "nan");
-  EXPECT_EQ(b[19], "0");
+  EXPECT_EQ(b[20], "nan");
+  EXPECT_EQ(b[22], "0");
 }
 
 TEST(BenchErrorTables, JsonRowsCarryEveryCsvColumn) {
@@ -246,6 +248,7 @@ TEST(BenchErrorTables, JsonRowsCarryEveryCsvColumn) {
   EXPECT_EQ(a.at("steps_run"), 8);
   EXPECT_DOUBLE_EQ(a.at("total_ms").get<double>(), 21.75);
   EXPECT_DOUBLE_EQ(a.at("mean_relative_error").get<double>(), 0.125);
+  EXPECT_DOUBLE_EQ(a.at("mean_relative_error_r").get<double>(), 0.25);
   EXPECT_EQ(a.at("pareto"), true);
   const nlohmann::json& b = j.at("rows").at(1);
   EXPECT_EQ(b.at("steps_requested"), "auto");

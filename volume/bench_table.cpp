@@ -200,7 +200,8 @@ std::vector<std::string> benchColumns() {
   return {"scene",          "backend",      "scheme",          "grid",         "steps_requested",
           "steps_run",      "shadow_map",   "voxelize_ms",     "resample_ms",  "shadow_map_ms",
           "injection_ms",   "propagation_ms", "shading_ms",    "total_ms",     "relative_mse",
-          "mean_relative_error", "rmse",    "ssim",            "mean_ratio",   "pareto"};
+          "mean_relative_error", "mean_relative_error_r", "mean_relative_error_g", "mean_relative_error_b",
+          "rmse",           "ssim",         "mean_ratio",      "pareto"};
 }
 
 std::string benchCsv(const std::vector<BenchRow>& rows) {
@@ -214,7 +215,8 @@ std::string benchCsv(const std::vector<BenchRow>& rows) {
         fixed(r.ms.voxelize, "%.3f"), fixed(r.ms.resample, "%.3f"), fixed(r.ms.shadowMap, "%.3f"),
         fixed(r.ms.injection, "%.3f"), fixed(r.ms.propagation, "%.3f"), fixed(r.ms.shading, "%.3f"),
         fixed(r.ms.total, "%.3f"), fixed(r.metrics.relativeMse, "%.6g"), fixed(r.metrics.meanRelativeError, "%.6g"),
-        fixed(r.metrics.rmse, "%.6g"), fixed(r.metrics.ssim, "%.6g"), fixed(r.metrics.meanRatio, "%.6g"),
+        fixed(r.metrics.meanRelativeErrorRgb.r, "%.6g"), fixed(r.metrics.meanRelativeErrorRgb.g, "%.6g"),
+        fixed(r.metrics.meanRelativeErrorRgb.b, "%.6g"), fixed(r.metrics.rmse, "%.6g"), fixed(r.metrics.ssim, "%.6g"), fixed(r.metrics.meanRatio, "%.6g"),
         r.pareto ? "1" : "0"};
     std::string line;
     for (const std::string& f : fields) line += (line.empty() ? "" : ",") + f;
@@ -246,6 +248,9 @@ std::string benchJson(const BenchRunInfo& info, const std::vector<BenchRow>& row
                      {"total_ms", number(r.ms.total)},
                      {"relative_mse", number(r.metrics.relativeMse)},
                      {"mean_relative_error", number(r.metrics.meanRelativeError)},
+                     {"mean_relative_error_r", number(r.metrics.meanRelativeErrorRgb.r)},
+                     {"mean_relative_error_g", number(r.metrics.meanRelativeErrorRgb.g)},
+                     {"mean_relative_error_b", number(r.metrics.meanRelativeErrorRgb.b)},
                      {"rmse", number(r.metrics.rmse)},
                      {"ssim", number(r.metrics.ssim)},
                      {"mean_ratio", number(r.metrics.meanRatio)},
