@@ -56,10 +56,12 @@ Lobes emitChannel(vec4 c, inout float emitted, inout float clampRemoved) {
                                       (kEmitLinear * kSide) * (s1p - s1m), (kEmitLinear * kSide) * (s2p - s2m));
     }
   }
-  const float power = c.x * kFluxPerC0;
-  const float raw = power > 0.0 ? total : 0.0;
+  // A cell driven below zero (a boundary whose retention is negative drains it) emits
+  // nothing, and what its lobe would have sent counts as removed, as on the CPU.
+  const float power = max(0.0, c.x * kFluxPerC0);
+  const float raw = total;
   const float scale = raw > 0.0 ? power / raw : 0.0;
-  emitted += max(0.0, power);
+  emitted += power;
   clampRemoved += max(0.0, raw - power);
   // Back to (c0, x, y, z): along x, b1 = y and b2 = z; along y, b1 = z and b2 = x; along
   // z, b1 = x and b2 = y.

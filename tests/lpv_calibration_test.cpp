@@ -89,12 +89,15 @@ TEST(LpvCalibration, DiffusionBoundaryCoefficientFromTheFresnelMoments) {
 TEST(LpvCalibration, RetentionPutsTheLinearProfilesZeroAtTheExtrapolationLength) {
   // With w(0) = ρ w(1) one cell apart, the line through them is zero Δx / (1 - ρ) from
   // layer 1's centre, i.e. Δx / (1 - ρ) - Δx / 2 beyond the face.
+  // Below Δx / 2 (z_b 0.3, 0.1) the zero lies inside the boundary cell and ρ < 0; at
+  // z_b = 0 it is on the face, ρ = kMinRetention.
   const double cellSize = 0.7;
-  for (double zb : {0.4, 1.0, 2.5, 5.0}) {
+  for (double zb : {0.0, 0.1, 0.3, 0.4, 1.0, 2.5, 5.0}) {
     const double rho = boundaryRetention(zb, cellSize);
     EXPECT_NEAR(cellSize / (1.0 - rho) - 0.5 * cellSize, zb, 1e-12) << "z_b " << zb;
   }
-  EXPECT_EQ(boundaryRetention(0.3, cellSize), 0.0);  // below the bare lattice's Δx / 2
+  EXPECT_LT(boundaryRetention(0.3, cellSize), 0.0);
+  EXPECT_EQ(boundaryRetention(0.0, cellSize), kMinRetention);
   EXPECT_EQ(boundaryRetention(100.0, cellSize), kMaxRetention);
 }
 

@@ -174,8 +174,9 @@ double asymptoticDecay(double albedo) {
 
 double boundaryRetention(double extrapolationLength, double cellSize) {
   const double k = 2.0 * extrapolationLength / cellSize;
-  if (!(k > 1.0)) return 0.0;
-  return std::min(kMaxRetention, (k - 1.0) / (k + 1.0));
+  if (!(k >= 0.0)) return kMinRetention;
+  if (std::isinf(k)) return kMaxRetention;
+  return std::clamp((k - 1.0) / (k + 1.0), kMinRetention, kMaxRetention);
 }
 
 bool parseLpvScheme(std::string_view name, LpvScheme& scheme) {

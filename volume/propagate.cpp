@@ -345,10 +345,11 @@ void boundaryRetentionFromSurface(const MaterialGrid& material, const std::array
           for (int axis = 0; axis < 3; ++axis) {
             if (outsideAlong[axis] == 0) continue;
             // reach <= 0: the centre lies beyond the profile's zero (a barely covered cell
-            // of a dense medium), so the face keeps nothing.
+            // of a dense medium), so the face drains all it can (kMinRetention).
             const double perFace = std::isinf(zb) ? kMaxRetention
-                                   : reach > 0.0  ? std::clamp(1.0 - normal[axis] * dx / reach, 0.0, kMaxRetention)
-                                                  : 0.0;
+                                   : reach > 0.0
+                                       ? std::clamp(1.0 - normal[axis] * dx / reach, kMinRetention, kMaxRetention)
+                                       : kMinRetention;
             sum += perFace * outsideAlong[axis];
           }
           factors.retention[ch][i] = float(sum);
