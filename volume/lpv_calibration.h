@@ -30,8 +30,8 @@
 //     darker as the grid was refined (jade: x0.88 at 32³, x0.59 at 64³). So a boundary
 //     cell returns to itself the share ρ of the light it sends toward each outside
 //     neighbour: with a linear profile that puts the zero z_b beyond the face for
-//     ρ = (k - 1) / (k + 1), k = 2 z_b / Δx (ρ = 0 when z_b < Δx / 2, at most
-//     kMaxRetention), and light is injected isotropically where the refracted beam
+//     ρ = (k - 1) / (k + 1), k = 2 z_b / Δx (negative when z_b < Δx / 2, within
+//     [kMinRetention, kMaxRetention]), and light is injected isotropically where the refracted beam
 //     first scatters, max(z0 cos θt, Δx / 2) deep (θt: the beam's angle to the normal).
 //     A face tilted against the grid is a staircase of cells; computeStepFactors gives
 //     each of a boundary cell's outside faces its own ρ from the surface plane through
