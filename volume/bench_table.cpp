@@ -216,8 +216,8 @@ std::string benchCsv(const std::vector<BenchRow>& rows) {
         fixed(r.ms.injection, "%.3f"), fixed(r.ms.propagation, "%.3f"), fixed(r.ms.shading, "%.3f"),
         fixed(r.ms.total, "%.3f"), fixed(r.metrics.relativeMse, "%.6g"), fixed(r.metrics.meanRelativeError, "%.6g"),
         fixed(r.metrics.meanRelativeErrorRgb.r, "%.6g"), fixed(r.metrics.meanRelativeErrorRgb.g, "%.6g"),
-        fixed(r.metrics.meanRelativeErrorRgb.b, "%.6g"), fixed(r.metrics.rmse, "%.6g"), fixed(r.metrics.ssim, "%.6g"), fixed(r.metrics.meanRatio, "%.6g"),
-        r.pareto ? "1" : "0"};
+        fixed(r.metrics.meanRelativeErrorRgb.b, "%.6g"), fixed(r.metrics.rmse, "%.6g"),
+        fixed(r.metrics.ssim, "%.6g"), fixed(r.metrics.meanRatio, "%.6g"), r.pareto ? "1" : "0"};
     std::string line;
     for (const std::string& f : fields) line += (line.empty() ? "" : ",") + f;
     text += line + "\n";
