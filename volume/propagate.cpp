@@ -344,13 +344,11 @@ void boundaryRetentionFromSurface(const MaterialGrid& material, const std::array
           double sum = 0.0;
           for (int axis = 0; axis < 3; ++axis) {
             if (outsideAlong[axis] == 0) continue;
-            // reach <= 0: the centre lies beyond the profile's zero (a barely covered cell
-            // of a dense medium), so the face drains all it can (kMinRetention).
-            const double perFace = std::isinf(zb) ? kMaxRetention
-                                   : reach > 0.0
-                                       ? std::clamp(1.0 - normal[axis] * dx / reach, kMinRetention, kMaxRetention)
-                                       : kMinRetention;
-            sum += perFace * outsideAlong[axis];
+            // Along the axis the profile's zero is reach / |n_a| from the centre, that
+            // minus Δx / 2 beyond the face: the aligned rule at that distance. A centre
+            // beyond the zero (reach <= 0, a barely covered cell of a dense medium) gets
+            // a negative distance, so the face drains all it can (kMinRetention).
+            sum += boundaryRetention(reach / normal[axis] - 0.5 * dx, dx) * outsideAlong[axis];
           }
           factors.retention[ch][i] = float(sum);
         }
