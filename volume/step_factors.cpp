@@ -1,0 +1,235 @@
+// Per-cell step factors: the propagation's per-step band factors, and in the calibrated
+// scheme the exit gains, boundary retentions and injection depths the surface needs.
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "volume/lpv_stages.h"
+
+namespace sslpv {
+namespace {
+// The calibrated exit gain maps a homogeneous medium's lattice reflectance to the true
+// one. It is calibrated for light injected in the cell's own material: it is larger where
+// that light sits near the surface cell with little retention (dense cells, injected at
+// the Δx / 2 floor) than where it is injected deep behind a retaining boundary (thin
+// bright media at fine cells). A dense spot painted into a thin bright medium also
+// receives light diffusing in from its surroundings, and its larger gain would turn that
+// into a glow. So a cell uses the smallest gain among itself and the cells up to
+// kExitGainReach cells away along the axes whose reduced albedo (this channel) is at
+// least its own: the media its light can have come from in quantity. Inside a
+// homogeneous region nothing changes (all gains equal); a brighter cell never takes a
+// darker neighbour's gain (no fringes between painted media). (With the seed-style
+// cosine-lobe injection any absorbing spot had this problem; with the isotropic
+// injection at depth an absorbing spot's own gain is the smaller one.)
+constexpr int kExitGainReach = 2;
+
+void limitExitGainToNeighbours(const MaterialGrid& material, StepFactors& factors) {
+  const GridFrame& f = material.frame;
+  const std::size_t n = f.cellCount();
+  for (int ch = 0; ch < 3; ++ch) {
+    std::vector<float> albedo(n, 0.0f);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!factors.active[i]) continue;
+      const double g = material.g[i], sigmaS = material.sigmaS[i][ch], sigmaT = material.sigmaT[i][ch];
+      const double reducedT = sigmaT - sigmaS * g;
+      albedo[i] = reducedT > 0.0 ? float(sigmaS * (1.0 - g) / reducedT) : 0.0f;
+    }
+    const std::vector<float> own = factors.exitGain[ch];
+    tbb::parallel_for(0, f.dims.z, [&](int z) {
+      for (int y = 0; y < f.dims.y; ++y)
+        for (int x = 0; x < f.dims.x; ++x) {
+          const std::size_t i = f.index(x, y, z);
+          if (!factors.active[i]) continue;
+          float smallest = own[i];
+          for (int axis = 0; axis < 3; ++axis)
+            for (int d = -kExitGainReach; d <= kExitGainReach; ++d) {
+              glm::ivec3 other(x, y, z);
+              other[axis] += d;
+              if (d == 0 || other[axis] < 0 || other[axis] >= f.dims[axis]) continue;
+              const std::size_t j = f.index(other.x, other.y, other.z);
+              if (factors.active[j] && albedo[j] >= albedo[i]) smallest = std::min(smallest, own[j]);
+            }
+          factors.exitGain[ch][i] = smallest;
+        }
+    });
+  }
+}
+
+/// The coverage gradient over a cell's 3x3x3 neighbourhood (its direction points into the
+/// object): over a staircase of partly covered cells it follows the surface's plane rather
+/// than the axis of the nearest step. Active cells never touch the grid's edge, so the
+/// neighbours exist.
+glm::dvec3 coverageGradient(const MaterialGrid& material, int x, int y, int z) {
+  const GridFrame& f = material.frame;
+  glm::dvec3 gradient(0.0);
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        gradient += double(material.coverage[f.index(x + dx, y + dy, z + dz)]) * glm::dvec3(dx, dy, dz);
+  return gradient;
+}
+
+/// Multiplies each boundary cell's exit gain by staircaseExitCorrection for its surface
+/// normal, the direction of coverageGradient. Cells with no coverage change around them
+/// (interior, or an aligned face's flat side along which the gradient is axial) get
+/// |n|_1 = 1 and keep their gain.
+void correctStaircaseExit(const MaterialGrid& material, const std::array<std::vector<float>, 3>& freshShare,
+                          StepFactors& factors) {
+  const GridFrame& f = material.frame;
+  tbb::parallel_for(0, f.dims.z, [&](int z) {
+    for (int y = 0; y < f.dims.y; ++y)
+      for (int x = 0; x < f.dims.x; ++x) {
+        const std::size_t i = f.index(x, y, z);
+        if (!factors.active[i]) continue;
+        const glm::dvec3 gradient = coverageGradient(material, x, y, z);
+        const double length = glm::length(gradient);
+        if (!(length > 1e-6)) continue;
+        const double normalL1 = (std::abs(gradient.x) + std::abs(gradient.y) + std::abs(gradient.z)) / length;
+        for (int ch = 0; ch < 3; ++ch)
+          factors.exitGain[ch][i] *= float(staircaseExitCorrection(freshShare[ch][i], normalL1));
+      }
+  });
+}
+
+/// Volume of the unit cube below the plane n·x = alpha, for n with positive components
+/// (Scardovelli & Zaleski 2000): inclusion-exclusion over the corners the plane passes.
+double cubeVolumeBelowPlane(const glm::dvec3& n, double alpha) {
+  auto cube = [](double v) { return v > 0.0 ? v * v * v : 0.0; };
+  const double volume = cube(alpha) - cube(alpha - n.x) - cube(alpha - n.y) - cube(alpha - n.z) +
+                        cube(alpha - n.x - n.y) + cube(alpha - n.x - n.z) + cube(alpha - n.y - n.z) -
+                        cube(alpha - n.x - n.y - n.z);
+  return volume / (6.0 * n.x * n.y * n.z);
+}
+
+/// Depth of a cell's centre below a planar surface of unit normal n that leaves `coverage`
+/// of the cell inside, in cells (1/2 when the surface is the cell's outer face).
+double centreDepthBelowSurface(glm::dvec3 n, double coverage) {
+  // Components of exactly 0 would divide by zero; 1e-3 moves the depth by under 1e-3.
+  n = glm::max(glm::abs(n), glm::dvec3(1e-3));
+  n /= glm::length(n);
+  double low = 0.0, high = n.x + n.y + n.z;
+  for (int i = 0; i < 50; ++i) {
+    const double alpha = 0.5 * (low + high);
+    (cubeVolumeBelowPlane(n, alpha) < coverage ? low : high) = alpha;
+  }
+  return 0.5 * (low + high) - 0.5 * (n.x + n.y + n.z);
+}
+
+/// Turns the extrapolation lengths into each active cell's boundary retention: the share
+/// its outside (inactive) neighbours return, summed over them.
+///
+/// ρ = (k - 1) / (k + 1), k = 2 z_b / Δx (boundaryRetention) puts the linear profile's zero
+/// z_b beyond an axis-aligned face, D = Δx / 2 + z_b from the boundary cell's centre; it is
+/// 1 - Δx / D. A tilted surface is a staircase of cells whose centres sit at other depths
+/// d below it, with |nx| + |ny| + |nz| outside faces per Δx² of surface (up to sqrt 3):
+/// with the flat ρ on every face a 30° or 3D-diagonal face of a thick ketchup slab came out
+/// x0.92 / x0.88 of the same slab axis-aligned, one of marble x1.10 / x1.15. Along axis a
+/// the zero plane at D = d + z_b from the centre is D / |n_a| away, so each outside face
+/// along a returns ρ_a = 1 - |n_a| Δx / D: the same zero along every axis. n comes from the
+/// coverage gradient over the cell's 3x3x3 neighbourhood and d from the cell's own coverage
+/// cut by a plane of that normal.
+void boundaryRetentionFromSurface(const MaterialGrid& material, const std::array<std::vector<float>, 3>& extrapolation,
+                                  StepFactors& factors) {
+  const GridFrame& f = material.frame;
+  const double dx = f.cellSize;
+  tbb::parallel_for(0, f.dims.z, [&](int z) {
+    for (int y = 0; y < f.dims.y; ++y)
+      for (int x = 0; x < f.dims.x; ++x) {
+        const std::size_t i = f.index(x, y, z);
+        if (!factors.active[i]) continue;
+        glm::ivec3 outsideAlong(0);  // outside neighbours per axis
+        for (int axis = 0; axis < 3; ++axis)
+          for (int d = -1; d <= 1; d += 2) {
+            glm::ivec3 other(x, y, z);
+            other[axis] += d;
+            // Active cells never touch the grid's edge (the outer ring is inactive).
+            if (!factors.active[f.index(other.x, other.y, other.z)]) ++outsideAlong[axis];
+          }
+        for (int ch = 0; ch < 3; ++ch) factors.retention[ch][i] = 0.0f;
+        if (outsideAlong == glm::ivec3(0)) continue;
+        const glm::dvec3 gradient = coverageGradient(material, x, y, z);
+        // No gradient (a cell alone or in a one-cell sliver): the faces it has outside.
+        const glm::dvec3 normal = glm::length(gradient) > 0.0 ? glm::abs(glm::normalize(gradient))
+                                                             : glm::normalize(glm::dvec3(outsideAlong));
+        const double depth = centreDepthBelowSurface(normal, material.coverage[i]) * dx;
+        for (int ch = 0; ch < 3; ++ch) {
+          const double zb = extrapolation[ch][i];
+          const double reach = depth + zb;
+          double sum = 0.0;
+          for (int axis = 0; axis < 3; ++axis) {
+            if (outsideAlong[axis] == 0) continue;
+            // Along the axis the profile's zero is reach / |n_a| from the centre, that
+            // minus Δx / 2 beyond the face: the aligned rule at that distance. A centre
+            // beyond the zero (reach <= 0, a barely covered cell of a dense medium) gets
+            // a negative distance, so the face drains all it can (kMinRetention).
+            sum += boundaryRetention(reach / normal[axis] - 0.5 * dx, dx) * outsideAlong[axis];
+          }
+          factors.retention[ch][i] = float(sum);
+        }
+      }
+  });
+}
+
+}  // namespace
+
+StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, double ior) {
+  const GridFrame& f = material.frame;
+  const std::size_t n = f.cellCount();
+  StepFactors factors;
+  factors.scheme = scheme;
+  factors.ior = ior;
+  std::array<std::vector<float>, 3> extrapolation;  // z_b per channel and cell (calibrated)
+  for (int ch = 0; ch < 3; ++ch) {
+    factors.dc[ch].assign(n, 0.0f);
+    factors.linear[ch].assign(n, 0.0f);
+    factors.exitGain[ch].assign(n, 1.0f);
+    if (scheme == LpvScheme::Calibrated) {
+      factors.reducedAlbedo[ch].assign(n, 0.0f);
+      factors.retention[ch].assign(n, 0.0f);
+      extrapolation[ch].assign(n, 0.0f);
+      factors.injectionDepth[ch].assign(n, 0.0f);
+      factors.obliqueGain[ch].assign(n * kObliqueIntervals, 1.0f);
+    }
+  }
+  factors.active.assign(n, 0);
+  factors.rowActive.assign(std::size_t(f.dims.y) * f.dims.z, 0);
+  const double dx = f.cellSize;
+  std::array<std::vector<float>, 3> freshShare;
+  if (scheme == LpvScheme::Calibrated)
+    for (int ch = 0; ch < 3; ++ch) freshShare[ch].assign(n, 0.0f);
+  tbb::parallel_for(0, f.dims.z, [&](int z) {
+    for (int y = 0; y < f.dims.y; ++y)
+      for (int x = 0; x < f.dims.x; ++x) {
+        const std::size_t i = f.index(x, y, z);
+        if (!isActiveCell(material, x, y, z)) continue;
+        factors.active[i] = 1;
+        factors.rowActive[std::size_t(z) * f.dims.y + y] = 1;
+        for (int ch = 0; ch < 3; ++ch) {
+          const double sigmaT = material.sigmaT[i][ch], sigmaS = material.sigmaS[i][ch];
+          const CellTransport t = scheme == LpvScheme::Seed
+                                      ? seedTransport(sigmaT, sigmaS, material.g[i], dx)
+                                      : calibratedTransport(sigmaT, sigmaS, material.g[i], dx, ior);
+          factors.dc[ch][i] = t.dc;
+          factors.linear[ch][i] = t.linear;
+          factors.exitGain[ch][i] = t.exitGain;
+          if (scheme == LpvScheme::Calibrated) {
+            factors.reducedAlbedo[ch][i] = t.reducedAlbedo;
+            extrapolation[ch][i] = t.extrapolationLength;
+            factors.injectionDepth[ch][i] = t.injectionDepth;
+            freshShare[ch][i] = t.freshShare;
+            std::copy(t.obliqueGain.begin(), t.obliqueGain.end(),
+                      factors.obliqueGain[ch].begin() + std::ptrdiff_t(i * kObliqueIntervals));
+          }
+        }
+      }
+  });
+  if (scheme == LpvScheme::Calibrated) {
+    boundaryRetentionFromSurface(material, extrapolation, factors);
+    limitExitGainToNeighbours(material, factors);
+    correctStaircaseExit(material, freshShare, factors);
+  }
+  return factors;
+}
+
+}  // namespace sslpv
