@@ -19,7 +19,7 @@ constexpr std::uint32_t kBindings = 12;
 constexpr bool kTexelBinding[kBindings] = {true, false, false, true, true, false, false, false, false, true, false, true};
 constexpr VkDeviceSize kVec4 = 4 * sizeof(float);
 constexpr VkDeviceSize kFieldVec4PerCell = 3;   // one vec4 of (c0, c1x, c1y, c1z) per channel
-constexpr VkDeviceSize kFactorVec4PerCell = 3;  // (dc.rgb, active), (linear.rgb, 0), (retention.rgb, 0)
+constexpr VkDeviceSize kFactorVec4PerCell = SSLPV_FACTOR_VEC4_PER_CELL;
 constexpr VkDeviceSize kEnergyRowBytes = SSLPV_ENERGY_FLOATS * sizeof(float);
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
@@ -342,7 +342,8 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
   const std::size_t cells = frame_.cellCount();
   for (int ch = 0; ch < 3; ++ch)
     if (factors.dc[ch].size() != cells || factors.linear[ch].size() != cells ||
-        (!factors.retention[ch].empty() && factors.retention[ch].size() != cells))
+        (!factors.retention[ch].empty() && factors.retention[ch].size() != cells) ||
+        (!factors.freshGain[ch].empty() && factors.freshGain[ch].size() != cells))
       throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
   if (factors.active.size() != cells || factors.rowActive.size() != std::size_t(frame_.dims.y) * frame_.dims.z)
     throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
@@ -357,10 +358,12 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
           cell[ch] = factors.dc[ch][i];
           cell[4 + ch] = factors.linear[ch][i];
           cell[8 + ch] = factors.retention[ch].empty() ? 0.0f : factors.retention[ch][i];
+          cell[12 + ch] = factors.freshGain[ch].empty() ? 1.0f : factors.freshGain[ch][i];
         }
         cell[3] = factors.active[i] ? 1.0f : 0.0f;
         cell[7] = 0.0f;
         cell[11] = 0.0f;
+        cell[15] = 0.0f;
       }
   });
   if (staging_) {
@@ -370,6 +373,7 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
     commands_.submitAndWait();
   }
   active_ = factors.active;
+  freshGain_ = factors.freshGain;
   buildItems(factors);
 }
 
@@ -555,11 +559,10 @@ PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const P
   timings_ = GpuPropagationTimings{};
   const glm::dvec3 initialPower = gridPower(field);
   // The injected light counts as step 0 of the sum, exactly as on the CPU.
-  for (int k = 0; k < ShGrid::kPlanes; ++k)
-    std::transform(accumulated.planes[k].begin(), accumulated.planes[k].end(), field.planes[k].begin(),
-                   accumulated.planes[k].begin(), std::plus<float>());
   const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
-  if (frame_.dims.x < 3 || frame_.dims.y < 3 || frame_.dims.z < 3 || maxSteps <= 0) {
+  const bool stepping = frame_.dims.x >= 3 && frame_.dims.y >= 3 && frame_.dims.z >= 3 && maxSteps > 0;
+  addInjected(stepping ? freshGain_ : std::array<std::vector<float>, 3>{}, field, accumulated);
+  if (!stepping) {
     PropagationResult result;
     result.initialPower = initialPower;
     return result;

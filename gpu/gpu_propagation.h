@@ -135,6 +135,7 @@ class GpuPropagator {
   std::size_t itemCount_ = 0, coveredCells_ = 0, activeCells_ = 0;
   std::vector<LpvItem> items_;
   std::vector<unsigned char> active_;  ///< for uploads that keep only active cells
+  std::array<std::vector<float>, 3> freshGain_;  ///< StepFactors::freshGain, for run()'s start
   bool staging_ = false;
   bool tiledAccumulatedClean_ = false;   ///< zero outside the work items
   bool linearAccumulatedClean_ = false;  ///< zero outside the work items

@@ -83,8 +83,8 @@ Cell fetchHalo(ivec2 origin, int lane, int h, int z) {
 void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
   if (!interiorXY(x, y)) return;  // also outside the grid; the ring never holds light
   const int i = cellIndex(x, y, z);
-  const vec4 dc = texelFetch(factors, 3 * i);
-  const vec4 linear = texelFetch(factors, 3 * i + 1);
+  const vec4 dc = texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i);
+  const vec4 linear = texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 1);
   const float on = dc.w;
   vec4 value[3];
   for (int ch = 0; ch < 3; ++ch) {
@@ -98,8 +98,12 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
     // Overwriting multiplies the old value by 0: the buffer is cleared once at setup, so
     // it never holds a NaN.
     const float keep = push.accumulate == 1 ? 1.0 : 0.0;
+    // Step 0 of a device-resident run: its source is the injected light, which enters the
+    // accumulated light times the fresh gain (addInjected on the CPU).
+    const vec3 sourceGain = push.accumulate == 2 ? texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 3).xyz : vec3(1.0);
     for (int ch = 0; ch < 3; ++ch)
-      accumulated[3 * i + ch] = keep * texelFetch(accumulatedIn, 3 * i + ch) + texelFetch(sourceField, 3 * i + ch) + value[ch];
+      accumulated[3 * i + ch] =
+          keep * texelFetch(accumulatedIn, 3 * i + ch) + sourceGain[ch] * texelFetch(sourceField, 3 * i + ch) + value[ch];
   }
 }
 
@@ -107,7 +111,8 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
 /// (branch-free like fetchSource).
 vec3 fetchRetention(int x, int y, int z) {
   const bool valid = inGrid(x, y, z);
-  return valid ? texelFetch(factors, 3 * cellIndex(valid ? x : 0, valid ? y : 0, valid ? z : 0) + 2).xyz : vec3(0.0);
+  const int i = cellIndex(valid ? x : 0, valid ? y : 0, valid ? z : 0);
+  return valid ? texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 2).xyz : vec3(0.0);
 }
 
 Gathered nothing() { return Gathered(vec4[3](vec4(0.0), vec4(0.0), vec4(0.0))); }

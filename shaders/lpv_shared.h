@@ -35,6 +35,10 @@ namespace sslpv::gpu {
        SSLPV_TILE_X +                                                                              \
    (x) % SSLPV_TILE_X)
 
+/// vec4s of step factors per cell in the propagator's factor grid: (dc.rgb, active),
+/// (linear.rgb, 0), (retention.rgb, 0), (freshGain.rgb, 0) (StepFactors).
+#define SSLPV_FACTOR_VEC4_PER_CELL 4
+
 /// Push constants of the propagation step, the per-step reduction and the accumulation.
 #define SSLPV_LPV_STEP_PUSH_FIELDS(X)                                                       \
   X(int, dimsX)          /* grid cells per axis */                                        \
@@ -45,7 +49,7 @@ namespace sslpv::gpu {
   X(int, autoSteps)      /* 1: stop once a step adds < tolerance of accumulated power */  \
   X(float, autoTolerance)                                                                  \
   X(int, initPower)      /* 1: this step's source power starts the accumulated power */   \
-  X(int, accumulate)     /* 0: no; 1: accumulated += source + result; 2: = source + result */ \
+  X(int, accumulate)     /* 0: no; 1: accumulated += source + result; 2: = freshGain source + result */ \
   X(int, leftoverParity) /* the accumulation kernel adds the last field if stepsRun % 2 is this */ \
   X(int, stepLimit)      /* ... once stepsRun reaches this or auto steps stopped */       \
   X(float, autoTailTolerance) /* and the estimated power still to come is below this */

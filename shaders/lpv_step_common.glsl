@@ -23,7 +23,7 @@ layout(std430, binding = 1) writeonly buffer DestinationField { vec4 destination
 layout(std430, binding = 2) writeonly buffer AccumulatedField { vec4 accumulated[]; };  // tiled
 // The same memory as binding 2: each cell is read and then written by one invocation.
 layout(binding = 3) uniform samplerBuffer accumulatedIn;
-// Per cell, tiled: (dc.rgb, active), (linear.rgb, 0), (retention.rgb, 0).
+// Per cell, tiled: SSLPV_FACTOR_VEC4_PER_CELL vec4s (lpv_shared.h).
 layout(binding = 4) uniform samplerBuffer factors;
 layout(std430, binding = 5) readonly buffer Items { uvec4 items[]; };
 layout(std430, binding = 6) writeonly buffer PartialSums { vec4 partials[]; };

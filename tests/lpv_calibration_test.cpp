@@ -333,6 +333,28 @@ TEST(LpvCalibration, StaircaseExitCorrectionUndoesTheDilutionOfUnpropagatedLight
   EXPECT_EQ(deep.freshShare, 0.0f);
 }
 
+TEST(LpvCalibration, GridPhaseFreshGainIsContinuous) {
+  // The fresh gain corrects an aligned face that lies inside its boundary cells; as the
+  // face reaches the cells' outer side (coverage -> 1) it must fade to 1, with no step.
+  // And its two forms of the Green's function (r < 1, and the r -> 1 limit for lossless
+  // cells) must agree where they meet.
+  const double cellSize = 1.0, ior = 1.3;
+  for (const Medium m : {Medium{0.07, 0.97}, Medium{0.03, 1.45}, Medium{2.19, 0.0021}, Medium{0.88, 0.17}}) {
+    const CellTransport t = calibratedTransport(m.sigmaT(), m.sigmaSPrime, 0.0, cellSize, ior);
+    const auto gain = [&](double survival, double coverage) {
+      return gridPhaseFreshGain(survival, t.extrapolationLength, t.injectionDepth, cellSize, coverage);
+    };
+    EXPECT_NEAR(gain(t.dc, 0.9999), 1.0, 2e-3) << "sigma_s' " << m.sigmaSPrime;
+    for (double coverage : {0.2, 0.5, 0.8}) {
+      const double g = gain(t.dc, coverage);
+      EXPECT_GE(g, 0.0);
+      EXPECT_LE(g, kMaxFreshGain);
+      // s = 1 - 1e-15 takes the limit form (1 - r < 1e-7), 1 - 1e-11 the general one.
+      EXPECT_NEAR(gain(1.0 - 1e-15, coverage), gain(1.0 - 1e-11, coverage), 1e-3) << "coverage " << coverage;
+    }
+  }
+}
+
 TEST(LpvCalibration, SeedSchemeIsTheSeedsFormula) {
   const CellTransport t = seedTransport(2.0, 1.5, 0.4, 0.25);
   const double e = std::exp(-0.5), scattered = 0.75 * (1.0 - e);

@@ -212,6 +212,62 @@ double staircaseExitCorrection(double freshShare, double normalL1) {
   return 1.0 / (1.0 - f + f / std::clamp(normalL1, 1.0, std::sqrt(3.0)));
 }
 
+namespace {
+
+/// The shaded value of layers 1 and 2 (weights a and 1 - a) for an aligned face covering
+/// `coverage` of its boundary cells, in all and of the light not yet propagated, up to a
+/// factor common to every coverage (the derivation at the top of this file, with
+/// G(n, m) = u(min) r^max / (b (1/r - r)) written as r^|n-m| + β r^(n+m) over 1 - r so
+/// that it stays finite as s -> 1).
+struct ShadedValue {
+  double total = 0.0, fresh = 0.0;
+};
+ShadedValue alignedFaceShadedValue(double s, double zb, double z0, double dx, double c) {
+  const double a4 = 6.0 / s - 4.0;
+  const double r = a4 > 2.0 ? 2.0 / (a4 + std::sqrt(a4 * a4 - 4.0)) : 1.0;
+  // The centre is (c - 1/2) Δx deep, so the profile's zero is zb + (c - 1/2) Δx from it.
+  const double rho = boundaryRetention(zb + (c - 1.0) * dx, dx);
+  const auto green = [&](int n, int m) {
+    if (1.0 - r < 1e-7) return 2.0 * (std::min(n, m) + rho / (1.0 - rho));  // the r -> 1 limit
+    // β r^(n+m), β = (ρ/r - 1) / (1 - ρ r), without dividing by r.
+    const double reflected = (rho * std::pow(r, n + m - 1) - std::pow(r, n + m)) / (1.0 - rho * r);
+    return (std::pow(r, std::abs(n - m)) + reflected) / (1.0 - r);
+  };
+  // The injection point max(z0, Δx/2) below the face, between the layers' centres at
+  // (c - 1/2) Δx, (c + 1/2) Δx, ...; its weights are trilinear times coverage.
+  const double layer = std::max(z0, 0.5 * dx) / dx + 1.5 - c;
+  int deep = 1;
+  double nearShare = 1.0;
+  if (layer > 1.0) {
+    deep = int(std::floor(layer));
+    const double f = layer - deep;
+    const double nearWeight = (1.0 - f) * (deep == 1 ? c : 1.0);
+    nearShare = nearWeight / (nearWeight + f);
+  }
+  const auto held = [&](int n) { return nearShare * green(n, deep) + (1.0 - nearShare) * green(n, deep + 1); };
+  const auto injected = [&](int n) { return (n == deep ? nearShare : 0.0) + (n == deep + 1 ? 1.0 - nearShare : 0.0); };
+  // The shading reads Δx/2 below the face: trilinear weights c and 1 - c times coverage.
+  const double first = c * c / (c * c + 1.0 - c);
+  ShadedValue v;
+  // green is G s (1 + r) / (6 r): the held light in units of the injected power.
+  v.total = (first * held(1) + (1.0 - first) * held(2)) * 6.0 * r / (s * (1.0 + r));
+  v.fresh = first * injected(1) + (1.0 - first) * injected(2);
+  return v;
+}
+
+}  // namespace
+
+double gridPhaseFreshGain(double survival, double extrapolationLength, double injectionDepth, double cellSize,
+                          double coverage) {
+  if (!(survival > 0.0) || !(cellSize > 0.0) || !(coverage > 0.0) || coverage >= 1.0) return 1.0;
+  const double s = std::min(survival, 1.0);
+  const ShadedValue aligned = alignedFaceShadedValue(s, extrapolationLength, injectionDepth, cellSize, 1.0);
+  const ShadedValue phased = alignedFaceShadedValue(s, extrapolationLength, injectionDepth, cellSize, coverage);
+  if (!(phased.fresh > 0.0)) return 1.0;
+  const double gain = 1.0 + (aligned.total - phased.total) / phased.fresh;
+  return std::isfinite(gain) ? std::clamp(gain, 0.0, kMaxFreshGain) : 1.0;
+}
+
 double obliqueEntryGain(const float* nodes, double y) {
   // Node k sits at y = 1 - k / kObliqueIntervals; y = 1 (k = 0) has gain 1.
   const double x = std::clamp((1.0 - y) * kObliqueIntervals, 0.0, double(kObliqueIntervals));

@@ -119,6 +119,11 @@ struct StepFactors {
   /// times ρ of what it sends one neighbour (isotropic cells send each neighbour 1/6).
   /// Empty in the seed scheme, whose boundary loses everything sent across it.
   std::array<std::vector<float>, 3> retention;
+  /// Calibrated scheme: per channel, per cell, the gain on the injected light as it enters
+  /// the accumulated light (gridPhaseFreshGain; 1 away from aligned faces that fall inside
+  /// their cells). The propagation carries the injected light unscaled. Empty in the seed
+  /// scheme.
+  std::array<std::vector<float>, 3> freshGain;
   /// Calibrated scheme: per channel, per cell, CellTransport::injectionDepth (scene
   /// units). Empty in the seed scheme.
   std::array<std::vector<float>, 3> injectionDepth;
@@ -138,6 +143,11 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme = 
 
 /// Flux a cell with coefficients (c0, cx, cy, cz) sends through the 5 faces of each of
 /// its 6 neighbours (order -x, +x, -y, +y, -z, +z), clamped as the propagation clamps.
+/// accumulated += the injected light times `freshGain` per channel and cell
+/// (StepFactors::freshGain; empty: 1). The start of a propagation that runs steps; with
+/// no step the injected light is added as is (GpuPropagator starts the same way).
+void addInjected(const std::array<std::vector<float>, 3>& freshGain, const ShGrid& injected, ShGrid& accumulated);
+
 std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz);
 
 /// Propagates `field` (the injected light, replaced by the last step's light) for the

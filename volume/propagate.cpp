@@ -194,6 +194,22 @@ glm::dvec3 gridPower(const ShGrid& grid) {
   return power;
 }
 
+}  // namespace
+
+void addInjected(const std::array<std::vector<float>, 3>& freshGain, const ShGrid& injected, ShGrid& accumulated) {
+  for (int k = 0; k < ShGrid::kPlanes; ++k) {
+    const std::vector<float>& from = injected.planes[k];
+    std::vector<float>& to = accumulated.planes[k];
+    const std::vector<float>& gain = freshGain[std::size_t(k / 4)];
+    if (gain.empty())
+      std::transform(to.begin(), to.end(), from.begin(), to.begin(), std::plus<float>());
+    else
+      for (std::size_t i = 0; i < to.size(); ++i) to[i] += gain[i] * from[i];
+  }
+}
+
+namespace {
+
 /// One --steps auto decision (PropagationOptions::autoTolerance), per channel from the
 /// power in the grid after this step and the previous one (W) and the power accumulated
 /// so far including this step. lpv_reduce.comp applies the same rule on the GPU.
@@ -260,13 +276,12 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
   PropagationResult result;
   const GridFrame& f = field.frame;
   result.initialPower = gridPower(field);
-  for (int k = 0; k < ShGrid::kPlanes; ++k)
-    std::transform(accumulated.planes[k].begin(), accumulated.planes[k].end(), field.planes[k].begin(),
-                   accumulated.planes[k].begin(), std::plus<float>());
+  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
+  const bool stepping = f.dims.x >= 3 && f.dims.y >= 3 && f.dims.z >= 3 && maxSteps > 0;
+  addInjected(stepping ? factors.freshGain : std::array<std::vector<float>, 3>{}, field, accumulated);
   glm::dvec3 accumulatedPower = result.initialPower;
   glm::dvec3 previousInGrid = result.initialPower;
-  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
-  if (f.dims.x < 3 || f.dims.y < 3 || f.dims.z < 3) return result;
+  if (!stepping) return result;
 
   ShGrid next;
   next.resize(f);
