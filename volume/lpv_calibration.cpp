@@ -227,11 +227,18 @@ ShadedValue alignedFaceShadedValue(double s, double zb, double z0, double dx, do
   const double r = a4 > 2.0 ? 2.0 / (a4 + std::sqrt(a4 * a4 - 4.0)) : 1.0;
   // The centre is (c - 1/2) Δx deep, so the profile's zero is zb + (c - 1/2) Δx from it.
   const double rho = boundaryRetention(zb + (c - 1.0) * dx, dx);
+  // r^k by multiplication: k is a few layers, and this runs for every boundary cell.
+  const auto power = [r](int k) {
+    double p = 1.0;
+    for (int j = 0; j < k; ++j) p *= r;
+    return p;
+  };
   const auto green = [&](int n, int m) {
     if (1.0 - r < 1e-7) return 2.0 * (std::min(n, m) + rho / (1.0 - rho));  // the r -> 1 limit
     // β r^(n+m), β = (ρ/r - 1) / (1 - ρ r), without dividing by r.
-    const double reflected = (rho * std::pow(r, n + m - 1) - std::pow(r, n + m)) / (1.0 - rho * r);
-    return (std::pow(r, std::abs(n - m)) + reflected) / (1.0 - r);
+    const double below = power(n + m - 1);
+    const double reflected = (rho * below - below * r) / (1.0 - rho * r);
+    return (power(std::abs(n - m)) + reflected) / (1.0 - r);
   };
   // The injection point max(z0, Δx/2) below the face, between the layers' centres at
   // (c - 1/2) Δx, (c + 1/2) Δx, ...; its weights are trilinear times coverage.
@@ -266,6 +273,40 @@ double gridPhaseFreshGain(double survival, double extrapolationLength, double in
   if (!(phased.fresh > 0.0)) return 1.0;
   const double gain = 1.0 + (aligned.total - phased.total) / phased.fresh;
   return std::isfinite(gain) ? std::clamp(gain, 0.0, kMaxFreshGain) : 1.0;
+}
+
+std::array<double, kObliqueIntervals> gridPhaseObliqueFactors(double survival, double extrapolationLength,
+                                                              double injectionDepth, double cellSize, double ior,
+                                                              double coverage, double freshGain, double alignedWeight) {
+  std::array<double, kObliqueIntervals> factors;
+  factors.fill(1.0);
+  if (!(survival > 0.0) || !(cellSize > 0.0) || !(injectionDepth > 0.0)) return factors;
+  const double s = std::min(survival, 1.0);
+  const auto shaded = [&](double depth, double c) {
+    return alignedFaceShadedValue(s, extrapolationLength, depth, cellSize, c);
+  };
+  // A tilted face's cells take every phase along it: 8 midpoints of the coverage (16 move
+  // the factors by under 0.2 %).
+  constexpr int kPhases = 8;
+  const auto phaseAverage = [&](double depth) {
+    double sum = 0.0;
+    for (int j = 0; j < kPhases; ++j) sum += shaded(depth, (j + 0.5) / kPhases).total;
+    return sum / kPhases / shaded(depth, 1.0).total;
+  };
+  const double tiltedNormal = alignedWeight < 1.0 ? phaseAverage(injectionDepth) : 1.0;
+  const bool phased = coverage > 0.0 && coverage < 1.0 && alignedWeight > 0.0;
+  for (int k = 1; k <= kObliqueIntervals; ++k) {
+    const double depth = injectionDepth * refractedCosine(obliqueNodeCosineSquared(k, ior), ior);
+    double aligned = 1.0, tilted = 1.0;
+    if (phased) {
+      const ShadedValue v = shaded(depth, coverage);
+      aligned = shaded(depth, 1.0).total / (v.total + (freshGain - 1.0) * v.fresh);
+    }
+    if (alignedWeight < 1.0) tilted = tiltedNormal / phaseAverage(depth);
+    const double factor = alignedWeight * aligned + (1.0 - alignedWeight) * tilted;
+    if (std::isfinite(factor) && factor > 0.0) factors[std::size_t(k - 1)] = factor;
+  }
+  return factors;
 }
 
 double obliqueEntryGain(const float* nodes, double y) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "volume/lpv_stages.h"
 
@@ -178,23 +179,28 @@ void boundaryRetentionFromSurface(const MaterialGrid& material, const std::array
 /// averages the phases (the correction's mean over a cycle is within 2 % of 1).
 constexpr double kPhaseAlignedDeg = 5.0, kPhaseTiltedDeg = 15.0;
 
-/// Sets the fresh gain of the two layers the shading reads below an axis-aligned face to
-/// gridPhaseFreshGain for the boundary cell's coverage: without it a face that falls
-/// inside its cells read up to 16 % dark or 10 % bright depending on where the grid
-/// happened to fall (ketchup_box's top at 32³: green and blue 0.85 of the path tracer).
-/// The inner cell takes its boundary cell's factor; one that lies inward of several
-/// (inside an edge) takes their mean.
+/// Corrects for where the grid falls against the surface (lpv_calibration.h,
+/// gridPhaseFreshGain and gridPhaseObliqueFactors): without it an aligned face that falls
+/// inside its cells read up to a third dark or 10 % bright depending on where the grid
+/// happened to fall (ketchup_box's top at 32³: green and blue 0.85 of the path tracer),
+/// and a tilted face lit obliquely 10-15 % dark in low-albedo channels.
+///  - The boundary cell of an aligned face gets the fresh gain and oblique factors for its
+///    coverage. The cell inward of it, which the shading also reads and which the
+///    injection picks as the surface cell when the coverage is low, gets the same (the
+///    mean, inside an edge where it lies inward of several).
+///  - A cell on a tilted face gets the phase-averaged oblique factors; between 5° and 15°
+///    from an axis the two blend.
 void correctGridPhase(const MaterialGrid& material, const std::array<std::vector<float>, 3>& extrapolation,
                       StepFactors& factors) {
   const GridFrame& f = material.frame;
   const std::size_t n = f.cellCount();
   const double dx = f.cellSize;
-  const double cosTilted = std::cos(kPhaseTiltedDeg * SSLPV_PI / 180.0);
-  std::array<std::vector<float>, 3> correction;
-  for (auto& c : correction) c.assign(n, 1.0f);
   constexpr std::size_t kNone = ~std::size_t(0);
-  std::vector<std::size_t> inner(n, kNone);  // a boundary cell's inward neighbour
+  // Per cell: its aligned weight (-1: no surface around it), whether it is an aligned
+  // face's boundary cell, that face's coverage, and the boundary cell's inward neighbour.
+  std::vector<float> alignedWeight(n, -1.0f), faceCoverage(n, 1.0f);
   std::vector<char> boundary(n, 0);
+  std::vector<std::size_t> inner(n, kNone);
   tbb::parallel_for(0, f.dims.z, [&](int z) {
     for (int y = 0; y < f.dims.y; ++y)
       for (int x = 0; x < f.dims.x; ++x) {
@@ -207,45 +213,67 @@ void correctGridPhase(const MaterialGrid& material, const std::array<std::vector
         for (int a = 1; a < 3; ++a)
           if (std::abs(normal[a]) > std::abs(normal[axis])) axis = a;
         const double alignment = std::abs(normal[axis]);
-        if (alignment <= cosTilted) continue;
         const double angle = std::acos(std::min(1.0, alignment)) * 180.0 / SSLPV_PI;
         const double weight = std::clamp((kPhaseTiltedDeg - angle) / (kPhaseTiltedDeg - kPhaseAlignedDeg), 0.0, 1.0);
+        alignedWeight[i] = float(weight);
         const int inward = normal[axis] > 0.0 ? 1 : -1;
         glm::ivec3 outside(x, y, z), inside(x, y, z);
         outside[axis] -= inward;
         inside[axis] += inward;
-        // Only the boundary cell of the face along its axis; active cells never touch the
-        // grid's edge, so both neighbours exist.
-        if (factors.active[f.index(outside.x, outside.y, outside.z)]) continue;
+        // Active cells never touch the grid's edge, so both neighbours exist.
+        if (weight == 0.0 || factors.active[f.index(outside.x, outside.y, outside.z)]) continue;
         boundary[i] = 1;
         const double centreDepth = centreDepthBelowSurface(glm::abs(normal), material.coverage[i]) / alignment;
-        const double coverage = std::clamp(centreDepth + 0.5, 0.0, 1.0);
-        for (int ch = 0; ch < 3; ++ch) {
-          const double k = gridPhaseFreshGain(factors.dc[ch][i], extrapolation[ch][i],
-                                              factors.injectionDepth[ch][i], dx, coverage);
-          correction[ch][i] = float(1.0 + weight * (k - 1.0));
-        }
+        faceCoverage[i] = float(std::clamp(centreDepth + 0.5, 0.0, 1.0));
         const std::size_t j = f.index(inside.x, inside.y, inside.z);
         if (factors.active[j]) inner[i] = j;
       }
   });
-  // The inner cells, serially: several boundary cells can share one.
-  std::array<std::vector<float>, 3> innerSum;
-  for (auto& c : innerSum) c.assign(n, 0.0f);
+  // The inner cells' face coverage, serially: several boundary cells can share one.
+  std::vector<float> innerCoverage(n, 0.0f);
   std::vector<int> innerCount(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t j = inner[i];
-    if (j == kNone) continue;
+    if (j == kNone || boundary[j]) continue;
     ++innerCount[j];
-    for (int ch = 0; ch < 3; ++ch) innerSum[ch][j] += correction[ch][i];
+    innerCoverage[j] += faceCoverage[i];
   }
-  for (std::size_t i = 0; i < n; ++i)
-    for (int ch = 0; ch < 3; ++ch) {
-      // A cell that is a boundary cell itself keeps its own factor.
-      const float factor =
-          boundary[i] || innerCount[i] == 0 ? correction[ch][i] : innerSum[ch][i] / float(innerCount[i]);
-      factors.freshGain[ch][i] = factor;
-    }
+  using ObliqueNodes = std::array<double, kObliqueIntervals>;
+  tbb::parallel_for(0, f.dims.z, [&](int z) {
+    std::map<std::array<float, 3>, ObliqueNodes> tiltedByMedium;
+    for (int y = 0; y < f.dims.y; ++y)
+      for (int x = 0; x < f.dims.x; ++x) {
+        const std::size_t i = f.index(x, y, z);
+        const double weight = alignedWeight[i];
+        if (weight < 0.0) continue;
+        const double coverage = innerCount[i] > 0 ? innerCoverage[i] / innerCount[i] : faceCoverage[i];
+        if (weight == 1.0 && coverage == 1.0) continue;  // no phase to correct
+        for (int ch = 0; ch < 3; ++ch) {
+          const double survival = factors.dc[ch][i], zb = extrapolation[ch][i], depth = factors.injectionDepth[ch][i];
+          const double fresh = 1.0 + weight * (gridPhaseFreshGain(survival, zb, depth, dx, coverage) - 1.0);
+          factors.freshGain[ch][i] = float(fresh);
+          ObliqueNodes nodes;
+          nodes.fill(0.0);
+          if (weight < 1.0) {
+            // The tilted factors depend on the medium only: once per medium and slice.
+            const std::array<float, 3> key{float(survival), float(zb), float(depth)};
+            auto found = tiltedByMedium.find(key);
+            if (found == tiltedByMedium.end())
+              found = tiltedByMedium
+                          .emplace(key, gridPhaseObliqueFactors(survival, zb, depth, dx, factors.ior, 1.0, 1.0, 0.0))
+                          .first;
+            for (int k = 0; k < kObliqueIntervals; ++k) nodes[std::size_t(k)] = (1.0 - weight) * found->second[std::size_t(k)];
+          }
+          if (weight > 0.0) {
+            const ObliqueNodes aligned =
+                gridPhaseObliqueFactors(survival, zb, depth, dx, factors.ior, coverage, fresh, 1.0);
+            for (int k = 0; k < kObliqueIntervals; ++k) nodes[std::size_t(k)] += weight * aligned[std::size_t(k)];
+          }
+          float* gain = &factors.obliqueGain[ch][i * std::size_t(kObliqueIntervals)];
+          for (int k = 0; k < kObliqueIntervals; ++k) gain[k] *= float(nodes[std::size_t(k)]);
+        }
+      }
+  });
 }
 
 }  // namespace
