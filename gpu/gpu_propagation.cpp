@@ -188,7 +188,9 @@ GpuPropagator::GpuPropagator(const VulkanDevice& device, const GridFrame& frame,
   const std::size_t tiledCells = std::size_t(tilesX_) * SSLPV_TILE_X * tilesY_ * options_.tileRows * std::max(frame.dims.z, 1);
   const VkDeviceSize fieldBytes = std::max<std::size_t>(frame.cellCount(), 1) * kFieldVec4PerCell * kVec4;
   const VkDeviceSize tiledBytes = tiledCells * kFieldVec4PerCell * kVec4;
-  if (tiledBytes > limits.maxStorageBufferRange || tiledCells * kFieldVec4PerCell > limits.maxTexelBufferElements)
+  // The factor grid has the most texels per cell (it is read only through its texel view).
+  const VkDeviceSize texelsPerCell = std::max(kFieldVec4PerCell, kFactorVec4PerCell);
+  if (tiledBytes > limits.maxStorageBufferRange || tiledCells * texelsPerCell > limits.maxTexelBufferElements)
     throw ResourceError("LPV grid " + std::to_string(frame.dims.x) + "x" + std::to_string(frame.dims.y) + "x" +
                         std::to_string(frame.dims.z) + " needs " + std::to_string(tiledBytes >> 20) +
                         " MiB per light field, more than the Vulkan device's storage-buffer range of " +
