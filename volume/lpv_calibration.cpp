@@ -225,7 +225,8 @@ struct ShadedValue {
 ShadedValue alignedFaceShadedValue(double s, double zb, double z0, double dx, double c) {
   const double a4 = 6.0 / s - 4.0;
   const double r = a4 > 2.0 ? 2.0 / (a4 + std::sqrt(a4 * a4 - 4.0)) : 1.0;
-  // The centre is (c - 1/2) Δx deep, so the profile's zero is zb + (c - 1/2) Δx from it.
+  // The centre is (c - 1/2) Δx deep, so the profile's zero is zb + (c - 1/2) Δx from it:
+  // the aligned rule at that distance less Δx / 2 (as boundaryRetentionFromSurface).
   const double rho = boundaryRetention(zb + (c - 1.0) * dx, dx);
   // r^k by multiplication: k is a few layers, and this runs for every boundary cell.
   const auto power = [r](int k) {

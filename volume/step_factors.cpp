@@ -172,11 +172,11 @@ void boundaryRetentionFromSurface(const MaterialGrid& material, const std::array
   });
 }
 
-/// Below these angles between a face's normal and the nearest axis the face counts as
-/// aligned (full grid-phase correction), above the second as tilted (none; the staircase
-/// rules cover it): over a face tilted by θ the boundary cell's phase cycles every
-/// 1 / tan θ cells, and from 15° (under 4 cells) the shading's 2-cell stencil already
-/// averages the phases (the correction's mean over a cycle is within 2 % of 1).
+/// Below the first of these angles between a face's normal and the nearest axis the face
+/// counts as aligned (each cell corrected for its own coverage), above the second as
+/// tilted (corrected for the phases averaged): over a face tilted by θ the boundary cell's
+/// phase cycles every 1 / tan θ cells, and from 15° (under 4 cells) the shading's 2-cell
+/// stencil already averages the phases.
 constexpr double kPhaseAlignedDeg = 5.0, kPhaseTiltedDeg = 15.0;
 
 /// Corrects for where the grid falls against the surface (lpv_calibration.h,
