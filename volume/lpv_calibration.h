@@ -37,7 +37,9 @@
 //     each of a boundary cell's outside faces its own ρ from the surface plane through
 //     the cell (so the profile's zero is z_b beyond the true surface along every axis),
 //     and corrects its exit gain for light read back before it propagates, which the
-//     staircase dilutes (staircaseExitCorrection).
+//     staircase dilutes (staircaseExitCorrection). Where the grid falls against a face
+//     (the boundary cells' coverage) is corrected from the same lattice's Green's function
+//     (gridPhaseFreshGain, gridPhaseObliqueFactors).
 //  4. Scales the exitant radiance by a coupling gain G so that a thick slab's diffuse
 //     reflectance is exact. For a semi-infinite layer stack under normal illumination
 //     the lattice's shaded reflectance is, in closed form (derivation in
