@@ -71,12 +71,10 @@ glm::dvec3 coverageGradient(const MaterialGrid& material, int x, int y, int z) {
   return gradient;
 }
 
-/// Multiplies each boundary cell's exit gain by staircaseExitCorrection for its surface
-/// normal, the direction of coverageGradient. Cells with no coverage change around them
-/// (interior, or an aligned face's flat side along which the gradient is axial) get
-/// |n|_1 = 1 and keep their gain.
-void correctStaircaseExit(const MaterialGrid& material, const std::array<std::vector<float>, 3>& freshShare,
-                          StepFactors& factors) {
+/// Calls visit(cell index, x, y, z, unit normal into the object) for every active cell
+/// with a coverage gradient (on or next to the surface), in parallel over slices.
+template <class Visit>
+void forEachSurfaceCell(const MaterialGrid& material, const StepFactors& factors, Visit&& visit) {
   const GridFrame& f = material.frame;
   tbb::parallel_for(0, f.dims.z, [&](int z) {
     for (int y = 0; y < f.dims.y; ++y)
@@ -86,10 +84,21 @@ void correctStaircaseExit(const MaterialGrid& material, const std::array<std::ve
         const glm::dvec3 gradient = coverageGradient(material, x, y, z);
         const double length = glm::length(gradient);
         if (!(length > 1e-6)) continue;
-        const double normalL1 = (std::abs(gradient.x) + std::abs(gradient.y) + std::abs(gradient.z)) / length;
-        for (int ch = 0; ch < 3; ++ch)
-          factors.exitGain[ch][i] *= float(staircaseExitCorrection(freshShare[ch][i], normalL1));
+        visit(i, x, y, z, gradient / length);
       }
+  });
+}
+
+/// Multiplies each boundary cell's exit gain by staircaseExitCorrection for its surface
+/// normal, the direction of coverageGradient. Cells with no coverage change around them
+/// (interior, or an aligned face's flat side along which the gradient is axial) get
+/// |n|_1 = 1 and keep their gain.
+void correctStaircaseExit(const MaterialGrid& material, const std::array<std::vector<float>, 3>& freshShare,
+                          StepFactors& factors) {
+  forEachSurfaceCell(material, factors, [&](std::size_t i, int, int, int, const glm::dvec3& normal) {
+    const double normalL1 = std::abs(normal.x) + std::abs(normal.y) + std::abs(normal.z);
+    for (int ch = 0; ch < 3; ++ch)
+      factors.exitGain[ch][i] *= float(staircaseExitCorrection(freshShare[ch][i], normalL1));
   });
 }
 
@@ -201,33 +210,25 @@ void correctGridPhase(const MaterialGrid& material, const std::array<std::vector
   std::vector<float> alignedWeight(n, -1.0f), faceCoverage(n, 1.0f);
   std::vector<char> boundary(n, 0);
   std::vector<std::size_t> inner(n, kNone);
-  tbb::parallel_for(0, f.dims.z, [&](int z) {
-    for (int y = 0; y < f.dims.y; ++y)
-      for (int x = 0; x < f.dims.x; ++x) {
-        const std::size_t i = f.index(x, y, z);
-        if (!factors.active[i]) continue;
-        const glm::dvec3 gradient = coverageGradient(material, x, y, z);
-        if (!(glm::length(gradient) > 1e-6)) continue;
-        const glm::dvec3 normal = glm::normalize(gradient);  // into the object
-        int axis = 0;
-        for (int a = 1; a < 3; ++a)
-          if (std::abs(normal[a]) > std::abs(normal[axis])) axis = a;
-        const double alignment = std::abs(normal[axis]);
-        const double angle = std::acos(std::min(1.0, alignment)) * 180.0 / SSLPV_PI;
-        const double weight = std::clamp((kPhaseTiltedDeg - angle) / (kPhaseTiltedDeg - kPhaseAlignedDeg), 0.0, 1.0);
-        alignedWeight[i] = float(weight);
-        const int inward = normal[axis] > 0.0 ? 1 : -1;
-        glm::ivec3 outside(x, y, z), inside(x, y, z);
-        outside[axis] -= inward;
-        inside[axis] += inward;
-        // Active cells never touch the grid's edge, so both neighbours exist.
-        if (weight == 0.0 || factors.active[f.index(outside.x, outside.y, outside.z)]) continue;
-        boundary[i] = 1;
-        const double centreDepth = centreDepthBelowSurface(glm::abs(normal), material.coverage[i]) / alignment;
-        faceCoverage[i] = float(std::clamp(centreDepth + 0.5, 0.0, 1.0));
-        const std::size_t j = f.index(inside.x, inside.y, inside.z);
-        if (factors.active[j]) inner[i] = j;
-      }
+  forEachSurfaceCell(material, factors, [&](std::size_t i, int x, int y, int z, const glm::dvec3& normal) {
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (std::abs(normal[a]) > std::abs(normal[axis])) axis = a;
+    const double alignment = std::abs(normal[axis]);
+    const double angle = std::acos(std::min(1.0, alignment)) * 180.0 / SSLPV_PI;
+    const double weight = std::clamp((kPhaseTiltedDeg - angle) / (kPhaseTiltedDeg - kPhaseAlignedDeg), 0.0, 1.0);
+    alignedWeight[i] = float(weight);
+    const int inward = normal[axis] > 0.0 ? 1 : -1;
+    glm::ivec3 outside(x, y, z), inside(x, y, z);
+    outside[axis] -= inward;
+    inside[axis] += inward;
+    // Active cells never touch the grid's edge, so both neighbours exist.
+    if (weight == 0.0 || factors.active[f.index(outside.x, outside.y, outside.z)]) return;
+    boundary[i] = 1;
+    const double centreDepth = centreDepthBelowSurface(glm::abs(normal), material.coverage[i]) / alignment;
+    faceCoverage[i] = float(std::clamp(centreDepth + 0.5, 0.0, 1.0));
+    const std::size_t j = f.index(inside.x, inside.y, inside.z);
+    if (factors.active[j]) inner[i] = j;
   });
   // The inner cells' face coverage, serially: several boundary cells can share one.
   std::vector<float> innerCoverage(n, 0.0f);
