@@ -561,8 +561,7 @@ PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const P
   timings_ = GpuPropagationTimings{};
   const glm::dvec3 initialPower = gridPower(field);
   // The injected light counts as step 0 of the sum, exactly as on the CPU.
-  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
-  const bool stepping = frame_.dims.x >= 3 && frame_.dims.y >= 3 && frame_.dims.z >= 3 && maxSteps > 0;
+  const bool stepping = propagationSteps(frame_, options);
   addInjected(stepping ? freshGain_ : std::array<std::vector<float>, 3>{}, field, accumulated);
   if (!stepping) {
     PropagationResult result;
@@ -591,8 +590,7 @@ PropagationResult GpuPropagator::run(ShGrid& field, ShGrid& accumulated, const P
 PropagationResult GpuPropagator::runOnDevice(const PropagationOptions& options) {
   timings_ = GpuPropagationTimings{};
   *control_.mappedAs<LpvControl>() = LpvControl{};  // the host loop reads it before the GPU resets it
-  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
-  if (frame_.dims.x < 3 || frame_.dims.y < 3 || frame_.dims.z < 3 || maxSteps <= 0) {
+  if (!propagationSteps(frame_, options)) {
     VkCommandBuffer cmd = commands_.begin();
     record(cmd, options);
     commands_.submitAndWait();
@@ -604,7 +602,7 @@ PropagationResult GpuPropagator::runOnDevice(const PropagationOptions& options) 
 void GpuPropagator::record(VkCommandBuffer cmd, const PropagationOptions& options) {
   const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
   prepareDeviceRun(cmd);
-  if (frame_.dims.x < 3 || frame_.dims.y < 3 || frame_.dims.z < 3 || maxSteps <= 0) {
+  if (!propagationSteps(frame_, options)) {
     // No step: the accumulated light is the injected light, wherever it is.
     const VkBufferCopy region{0, 0, linearAccumulated_.size()};
     vkCmdCopyBuffer(cmd, linearSource_.handle(), linearAccumulated_.handle(), 1, &region);

@@ -92,7 +92,7 @@ TEST(TiltedBoundary, ChannelsReflectAsTheAlignedSlabOverGridPhases) {
 // normal incidence ketchup 0.99-1.00 0.84-0.93 0.67-0.84, marble 0.86-0.93 0.83-0.92
 // 0.81-0.91, skin1 0.99-1.03 0.87-0.93 0.69-0.85 (before gridPhaseFreshGain); 80° ketchup
 // green 0.76-1.01, skin1 0.93-0.99 0.84-1.01 0.87-1.01 (with the fresh gain, before
-// gridPhaseObliqueFactors). With both every channel is within 0.989-1.013. Each must stay
+// the phase oblique factors). With both every channel is within 0.989-1.013. Each must stay
 // within 3 %.
 TEST(TiltedBoundary, AlignedSlabReflectsTheSameAtEveryGridPhase) {
   struct Case {
@@ -120,7 +120,7 @@ TEST(TiltedBoundary, AlignedSlabReflectsTheSameAtEveryGridPhase) {
 
 // A tilted face takes every phase along it. Lit obliquely its light sits shallower, where
 // the phase matters more. Tilted 30° over aligned, at 60° / 80° incidence, relative to the
-// same ratio at normal incidence, before gridPhaseObliqueFactors: ketchup 1.01 0.90 0.93 /
+// same ratio at normal incidence, before the phase oblique factors: ketchup 1.01 0.90 0.93 /
 // 1.02 0.86 0.94, skin1 0.97 0.93 0.94 / 0.96 0.91 0.94 (marble within 3 %). After: all
 // within 0.997-1.027. Each must stay within 3 % (the staircase's own error at normal
 // incidence is the first test's).

@@ -276,35 +276,51 @@ double gridPhaseFreshGain(double survival, double extrapolationLength, double in
   return std::isfinite(gain) ? std::clamp(gain, 0.0, kMaxFreshGain) : 1.0;
 }
 
-std::array<double, kObliqueIntervals> gridPhaseObliqueFactors(double survival, double extrapolationLength,
-                                                              double injectionDepth, double cellSize, double ior,
-                                                              double coverage, double freshGain, double alignedWeight) {
+namespace {
+
+/// The depth a beam at oblique node k (1 .. kObliqueIntervals) is injected at.
+double obliqueNodeDepth(double injectionDepth, double ior, int k) {
+  return injectionDepth * refractedCosine(obliqueNodeCosineSquared(k, ior), ior);
+}
+
+}  // namespace
+
+std::array<double, kObliqueIntervals> alignedPhaseObliqueFactors(double survival, double extrapolationLength,
+                                                                 double injectionDepth, double cellSize, double ior,
+                                                                 double coverage, double freshGain) {
+  std::array<double, kObliqueIntervals> factors;
+  factors.fill(1.0);
+  if (!(survival > 0.0) || !(cellSize > 0.0) || !(injectionDepth > 0.0) || !(coverage > 0.0) || coverage >= 1.0)
+    return factors;
+  const double s = std::min(survival, 1.0);
+  for (int k = 1; k <= kObliqueIntervals; ++k) {
+    const double depth = obliqueNodeDepth(injectionDepth, ior, k);
+    const ShadedValue phased = alignedFaceShadedValue(s, extrapolationLength, depth, cellSize, coverage);
+    const double onBoundary = alignedFaceShadedValue(s, extrapolationLength, depth, cellSize, 1.0).total;
+    const double factor = onBoundary / (phased.total + (freshGain - 1.0) * phased.fresh);
+    if (std::isfinite(factor) && factor > 0.0) factors[std::size_t(k - 1)] = factor;
+  }
+  return factors;
+}
+
+std::array<double, kObliqueIntervals> tiltedPhaseObliqueFactors(double survival, double extrapolationLength,
+                                                                double injectionDepth, double cellSize, double ior) {
   std::array<double, kObliqueIntervals> factors;
   factors.fill(1.0);
   if (!(survival > 0.0) || !(cellSize > 0.0) || !(injectionDepth > 0.0)) return factors;
   const double s = std::min(survival, 1.0);
-  const auto shaded = [&](double depth, double c) {
-    return alignedFaceShadedValue(s, extrapolationLength, depth, cellSize, c);
-  };
   // A tilted face's cells take every phase along it: 8 midpoints of the coverage (16 move
   // the factors by under 0.2 %).
   constexpr int kPhases = 8;
   const auto phaseAverage = [&](double depth) {
     double sum = 0.0;
-    for (int j = 0; j < kPhases; ++j) sum += shaded(depth, (j + 0.5) / kPhases).total;
-    return sum / kPhases / shaded(depth, 1.0).total;
+    for (int j = 0; j < kPhases; ++j)
+      sum += alignedFaceShadedValue(s, extrapolationLength, depth, cellSize, (j + 0.5) / kPhases).total;
+    return sum / kPhases / alignedFaceShadedValue(s, extrapolationLength, depth, cellSize, 1.0).total;
   };
-  const double tiltedNormal = alignedWeight < 1.0 ? phaseAverage(injectionDepth) : 1.0;
-  const bool phased = coverage > 0.0 && coverage < 1.0 && alignedWeight > 0.0;
+  const double normal = phaseAverage(injectionDepth);
   for (int k = 1; k <= kObliqueIntervals; ++k) {
-    const double depth = injectionDepth * refractedCosine(obliqueNodeCosineSquared(k, ior), ior);
-    double aligned = 1.0, tilted = 1.0;
-    if (phased) {
-      const ShadedValue v = shaded(depth, coverage);
-      aligned = shaded(depth, 1.0).total / (v.total + (freshGain - 1.0) * v.fresh);
-    }
-    if (alignedWeight < 1.0) tilted = tiltedNormal / phaseAverage(depth);
-    const double factor = alignedWeight * aligned + (1.0 - alignedWeight) * tilted;
+    const double factor = normal / phaseAverage(obliqueNodeDepth(injectionDepth, ior, k));
     if (std::isfinite(factor) && factor > 0.0) factors[std::size_t(k - 1)] = factor;
   }
   return factors;

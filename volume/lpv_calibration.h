@@ -39,7 +39,7 @@
 //     and corrects its exit gain for light read back before it propagates, which the
 //     staircase dilutes (staircaseExitCorrection). Where the grid falls against a face
 //     (the boundary cells' coverage) is corrected from the same lattice's Green's function
-//     (gridPhaseFreshGain, gridPhaseObliqueFactors).
+//     (gridPhaseFreshGain, alignedPhaseObliqueFactors, tiltedPhaseObliqueFactors).
 //  4. Scales the exitant radiance by a coupling gain G so that a thick slab's diffuse
 //     reflectance is exact. For a semi-infinite layer stack under normal illumination
 //     the lattice's shaded reflectance is, in closed form (derivation in
@@ -158,16 +158,19 @@ inline constexpr int kObliqueIntervals = SSLPV_OBLIQUE_INTERVALS;
 /// (z0 cos θt). The oblique gain is derived for a face on a cell boundary, and the phase
 /// matters more the shallower the light sits: a 30° staircase of ketchup at Δx = 1 mm
 /// read, in green, 1.00 of the aligned slab at normal incidence but 0.89 at 60° and 0.86
-/// at 80°, as the phase-averaged Green's function predicts (0.90, 0.86).
-///  - An aligned face inside its cells (coverage < 1, with its gridPhaseFreshGain): the
-///    exact factor at that coverage, reflectance on a cell boundary over that of the
-///    injection there plus the fresh gain's share.
-///  - A tilted face: the phase-averaged reflectance (8 coverages) at normal depth over
-///    that at the node's depth, both relative to a face on a cell boundary.
-/// `alignedWeight` (1 aligned, 0 tilted) blends the two; both are 1 at normal incidence.
-std::array<double, kObliqueIntervals> gridPhaseObliqueFactors(double survival, double extrapolationLength,
-                                                              double injectionDepth, double cellSize, double ior,
-                                                              double coverage, double freshGain, double alignedWeight);
+/// at 80°, as the phase-averaged Green's function predicts (0.90, 0.86). Both forms are 1
+/// at normal incidence.
+/// An aligned face inside its cells (coverage < 1, with its gridPhaseFreshGain): the exact
+/// factor at that coverage, reflectance on a cell boundary over that of the injection
+/// there plus the fresh gain's share.
+std::array<double, kObliqueIntervals> alignedPhaseObliqueFactors(double survival, double extrapolationLength,
+                                                                 double injectionDepth, double cellSize, double ior,
+                                                                 double coverage, double freshGain);
+/// A tilted face, whose cells take every phase along it: the phase-averaged reflectance
+/// (8 coverages) at normal depth over that at the node's depth, both relative to a face
+/// on a cell boundary. Depends on the medium only.
+std::array<double, kObliqueIntervals> tiltedPhaseObliqueFactors(double survival, double extrapolationLength,
+                                                                double injectionDepth, double cellSize, double ior);
 
 /// y = cos² θi of light outside that refracted into a medium of relative index `ior` at
 /// `cosRefracted` to the normal inside, clamped to [0, 1]. The injection reads this from

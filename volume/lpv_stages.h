@@ -141,13 +141,20 @@ struct StepFactors {
 StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme = LpvScheme::Seed,
                                double ior = 1.0);
 
-/// Flux a cell with coefficients (c0, cx, cy, cz) sends through the 5 faces of each of
-/// its 6 neighbours (order -x, +x, -y, +y, -z, +z), clamped as the propagation clamps.
+/// Whether a propagation on `frame` with `options` runs any step (a grid under 3 cells
+/// along an axis, or a step limit of 0, only accumulates the injected light).
+inline bool propagationSteps(const GridFrame& frame, const PropagationOptions& options) {
+  const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
+  return frame.dims.x >= 3 && frame.dims.y >= 3 && frame.dims.z >= 3 && maxSteps > 0;
+}
+
 /// accumulated += the injected light times `freshGain` per channel and cell
 /// (StepFactors::freshGain; empty: 1). The start of a propagation that runs steps; with
 /// no step the injected light is added as is (GpuPropagator starts the same way).
 void addInjected(const std::array<std::vector<float>, 3>& freshGain, const ShGrid& injected, ShGrid& accumulated);
 
+/// Flux a cell with coefficients (c0, cx, cy, cz) sends through the 5 faces of each of
+/// its 6 neighbours (order -x, +x, -y, +y, -z, +z), clamped as the propagation clamps.
 std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz);
 
 /// Propagates `field` (the injected light, replaced by the last step's light) for the

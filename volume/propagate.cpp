@@ -277,7 +277,7 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
   const GridFrame& f = field.frame;
   result.initialPower = gridPower(field);
   const int maxSteps = options.autoSteps ? options.maxAutoSteps : options.steps;
-  const bool stepping = f.dims.x >= 3 && f.dims.y >= 3 && f.dims.z >= 3 && maxSteps > 0;
+  const bool stepping = propagationSteps(f, options);
   addInjected(stepping ? factors.freshGain : std::array<std::vector<float>, 3>{}, field, accumulated);
   glm::dvec3 accumulatedPower = result.initialPower;
   glm::dvec3 previousInGrid = result.initialPower;

@@ -189,7 +189,7 @@ void boundaryRetentionFromSurface(const MaterialGrid& material, const std::array
 constexpr double kPhaseAlignedDeg = 5.0, kPhaseTiltedDeg = 15.0;
 
 /// Corrects for where the grid falls against the surface (lpv_calibration.h,
-/// gridPhaseFreshGain and gridPhaseObliqueFactors): without it an aligned face that falls
+/// gridPhaseFreshGain and the phase oblique factors): without it an aligned face that falls
 /// inside its cells read up to a third dark or 10 % bright depending on where the grid
 /// happened to fall (ketchup_box's top at 32³: green and blue 0.85 of the path tracer),
 /// and a tilted face lit obliquely 10-15 % dark in low-albedo channels.
@@ -256,18 +256,18 @@ void correctGridPhase(const MaterialGrid& material, const std::array<std::vector
           ObliqueNodes nodes;
           nodes.fill(0.0);
           if (weight < 1.0) {
-            // The tilted factors depend on the medium only: once per medium and slice.
+            // Once per medium and slice.
             const std::array<float, 3> key{float(survival), float(zb), float(depth)};
             auto found = tiltedByMedium.find(key);
             if (found == tiltedByMedium.end())
               found = tiltedByMedium
-                          .emplace(key, gridPhaseObliqueFactors(survival, zb, depth, dx, factors.ior, 1.0, 1.0, 0.0))
+                          .emplace(key, tiltedPhaseObliqueFactors(survival, zb, depth, dx, factors.ior))
                           .first;
             for (int k = 0; k < kObliqueIntervals; ++k) nodes[std::size_t(k)] = (1.0 - weight) * found->second[std::size_t(k)];
           }
           if (weight > 0.0) {
             const ObliqueNodes aligned =
-                gridPhaseObliqueFactors(survival, zb, depth, dx, factors.ior, coverage, fresh, 1.0);
+                alignedPhaseObliqueFactors(survival, zb, depth, dx, factors.ior, coverage, fresh);
             for (int k = 0; k < kObliqueIntervals; ++k) nodes[std::size_t(k)] += weight * aligned[std::size_t(k)];
           }
           float* gain = &factors.obliqueGain[ch][i * std::size_t(kObliqueIntervals)];
