@@ -1,6 +1,6 @@
 #include "volume/reference_tracer.h"
 
-#include <tbb/blocked_range2d.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -12,6 +12,9 @@
 #include <glm/trigonometric.hpp>
 #include <limits>
 #include <mutex>
+#include <numeric>
+#include <random>
+#include <vector>
 
 #include "volume/error.h"
 #include "volume/fresnel.h"
@@ -344,45 +347,58 @@ ReferenceResult ReferenceTracer::render(const ReferenceOptions& options) const {
   std::atomic<std::size_t> done{0};
   std::mutex progressMutex;
   constexpr int kTile = 16;
+  const int tilesX = (camera.width + kTile - 1) / kTile;
+  const int tilesY = (camera.height + kTile - 1) / kTile;
+  // Tiles in a fixed shuffled order: the object covers part of the image and its pixels
+  // cost 100-1000× a background one, so in scanline order the share of pixels done said
+  // nothing about the time left (a 100-minute marble reference showed "ETA 4s" at 16 %).
+  // Shuffled, the share of pixels done tracks the share of work done. Each pixel's
+  // samples depend only on (seed, pixel, sample), so the order changes no result.
+  std::vector<int> tileOrder(std::size_t(tilesX) * std::size_t(tilesY));
+  std::iota(tileOrder.begin(), tileOrder.end(), 0);
+  std::shuffle(tileOrder.begin(), tileOrder.end(), std::mt19937(0x5eed));
 
+  auto renderPixel = [&](const MaterialField::Sampler& field, int x, int y) {
+    const double u = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalfX;
+    const double v = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalfY;
+    const glm::dvec3 dir = glm::normalize(forward + u * right + v * up);
+    const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(camera.width) + std::uint64_t(x);
+    glm::dvec3 sum(0.0), sumSq(0.0);
+    for (int s = 0; s < options.spp; ++s) {
+      ReferenceRng rng(options.seed, pixel, std::uint64_t(s));
+      for (int c = 0; c < 3; ++c) {
+        const double l = impl_->trace(field, camera.position, dir, c, rng, options.maxScatterEvents);
+        sum[c] += l;
+        sumSq[c] += l * l;
+      }
+    }
+    const double n = options.spp;
+    const glm::dvec3 mean = sum / n;
+    glm::dvec3 se(0.0);
+    if (options.spp > 1) {
+      const glm::dvec3 variance = glm::max(glm::dvec3(0.0), (sumSq - n * mean * mean) / (n - 1.0));
+      se = glm::sqrt(variance / n);
+    }
+    result.radiance.at(x, y) = glm::vec3(mean);
+    result.standardError.at(x, y) = glm::vec3(se);
+  };
   auto work = [&] {
-    tbb::parallel_for(
-        tbb::blocked_range2d<int>(0, camera.height, kTile, 0, camera.width, kTile),
-        [&](const tbb::blocked_range2d<int>& tile) {
-          const MaterialField::Sampler field = impl_->object->field().sampler();
-          for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
-            for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
-              const double u = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalfX;
-              const double v = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalfY;
-              const glm::dvec3 dir = glm::normalize(forward + u * right + v * up);
-              const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(camera.width) + std::uint64_t(x);
-              glm::dvec3 sum(0.0), sumSq(0.0);
-              for (int s = 0; s < options.spp; ++s) {
-                ReferenceRng rng(options.seed, pixel, std::uint64_t(s));
-                for (int c = 0; c < 3; ++c) {
-                  const double l = impl_->trace(field, camera.position, dir, c, rng, options.maxScatterEvents);
-                  sum[c] += l;
-                  sumSq[c] += l * l;
-                }
-              }
-              const double n = options.spp;
-              const glm::dvec3 mean = sum / n;
-              glm::dvec3 se(0.0);
-              if (options.spp > 1) {
-                const glm::dvec3 variance = glm::max(glm::dvec3(0.0), (sumSq - n * mean * mean) / (n - 1.0));
-                se = glm::sqrt(variance / n);
-              }
-              result.radiance.at(x, y) = glm::vec3(mean);
-              result.standardError.at(x, y) = glm::vec3(se);
-            }
-          }
-          const std::size_t now = done.fetch_add(tile.rows().size() * tile.cols().size()) +
-                                  tile.rows().size() * tile.cols().size();
-          if (options.progress) {
-            std::lock_guard<std::mutex> lock(progressMutex);
-            options.progress(now, total);
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tileOrder.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        const MaterialField::Sampler field = impl_->object->field().sampler();
+                        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                          const int x0 = tileOrder[i] % tilesX * kTile, y0 = tileOrder[i] / tilesX * kTile;
+                          const int x1 = std::min(camera.width, x0 + kTile), y1 = std::min(camera.height, y0 + kTile);
+                          for (int y = y0; y < y1; ++y)
+                            for (int x = x0; x < x1; ++x) renderPixel(field, x, y);
+                          const std::size_t pixels = std::size_t(x1 - x0) * std::size_t(y1 - y0);
+                          const std::size_t now = done.fetch_add(pixels) + pixels;
+                          if (options.progress) {
+                            std::lock_guard<std::mutex> lock(progressMutex);
+                            options.progress(now, total);
+                          }
+                        }
+                      });
   };
   if (options.threads > 0) {
     tbb::task_arena arena(options.threads);
