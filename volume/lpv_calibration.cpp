@@ -72,6 +72,11 @@ double obliqueNodeCosineSquared(int k, double ior) {
 /// cos θt inside for light arriving at cos² θi = y outside.
 double refractedCosine(double y, double ior) { return std::sqrt(std::max(0.0, 1.0 - (1.0 - y) / (ior * ior))); }
 
+/// The depth a beam at oblique node k (1 .. kObliqueIntervals) is injected at.
+double obliqueNodeDepth(double injectionDepth, double ior, int k) {
+  return injectionDepth * refractedCosine(obliqueNodeCosineSquared(k, ior), ior);
+}
+
 /// Diffusely reflected power per entering power of a beam entering at cos² θi = y.
 double reflectancePerEntering(double albedo, double ior, double y) {
   AddingDoublingOptions options;
@@ -276,14 +281,6 @@ double gridPhaseFreshGain(double survival, double extrapolationLength, double in
   return std::isfinite(gain) ? std::clamp(gain, 0.0, kMaxFreshGain) : 1.0;
 }
 
-namespace {
-
-/// The depth a beam at oblique node k (1 .. kObliqueIntervals) is injected at.
-double obliqueNodeDepth(double injectionDepth, double ior, int k) {
-  return injectionDepth * refractedCosine(obliqueNodeCosineSquared(k, ior), ior);
-}
-
-}  // namespace
 
 std::array<double, kObliqueIntervals> alignedPhaseObliqueFactors(double survival, double extrapolationLength,
                                                                  double injectionDepth, double cellSize, double ior,
@@ -394,9 +391,8 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   }
   const double t01 = std::sqrt(1.0 - std::clamp(reducedAlbedo, 0.0, 1.0));
   for (int k = 1; k <= kObliqueIntervals; ++k) {
-    const double y = obliqueNodeCosineSquared(k, ior);
     const double medium = interpolateCubic(boundary.obliqueRatio[std::size_t(k - 1)], t01);
-    const double lattice = latticeReflectanceAt(injectionDepth * refractedCosine(y, ior));
+    const double lattice = latticeReflectanceAt(obliqueNodeDepth(injectionDepth, ior, k));
     double nodeGain = lattice > 0.0 ? medium * latticeReflectance / lattice : 1.0;
     if (!std::isfinite(nodeGain) || !(nodeGain > 0.0)) nodeGain = 1.0;
     t.obliqueGain[std::size_t(k - 1)] = float(nodeGain);
