@@ -345,7 +345,8 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
   for (int ch = 0; ch < 3; ++ch)
     if (factors.dc[ch].size() != cells || factors.linear[ch].size() != cells ||
         (!factors.retention[ch].empty() && factors.retention[ch].size() != cells) ||
-        (!factors.freshGain[ch].empty() && factors.freshGain[ch].size() != cells))
+        (!factors.freshGain[ch].empty() && factors.freshGain[ch].size() != cells) ||
+        (!factors.conductance[ch].empty() && factors.conductance[ch].size() != cells))
       throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
   if (factors.active.size() != cells || factors.rowActive.size() != std::size_t(frame_.dims.y) * frame_.dims.z)
     throw GpuError("GpuPropagator: step factors are not on the propagator's frame");
@@ -361,11 +362,13 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
           cell[4 + ch] = factors.linear[ch][i];
           cell[8 + ch] = factors.retention[ch].empty() ? 0.0f : factors.retention[ch][i];
           cell[12 + ch] = factors.freshGain[ch].empty() ? 1.0f : factors.freshGain[ch][i];
+          cell[16 + ch] = factors.conductance[ch].empty() ? 1.0f : factors.conductance[ch][i];
         }
         cell[3] = factors.active[i] ? 1.0f : 0.0f;
         cell[7] = 0.0f;
         cell[11] = 0.0f;
         cell[15] = 0.0f;
+        cell[19] = 0.0f;
       }
   });
   if (staging_) {

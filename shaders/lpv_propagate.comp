@@ -57,22 +57,34 @@ struct CellLobes {
   Lobes ch[3];
 };
 
-CellLobes emitCell(Cell raw, float owned, inout StepSums sums) {
+/// Each face passes conductance[i] · conductance[j]: the sender's factor is applied here,
+/// the receiver's in storeCell, as on the CPU (gatherSlice).
+vec3 fetchConductance(int x, int y, int z) {
+  const bool valid = inGrid(x, y, z);
+  const int i = cellIndex(valid ? x : 0, valid ? y : 0, valid ? z : 0);
+  return texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 4).xyz;
+}
+
+/// The lobes of source cell (x, y, z).
+CellLobes emitCell(int x, int y, int z, float owned, inout StepSums sums) {
+  const Cell raw = fetchSource(x, y, z);
+  const vec3 conductance = fetchConductance(x, y, z);
   CellLobes lobes;
   vec3 emitted = vec3(0.0), clampRemoved = vec3(0.0);
-  for (int ch = 0; ch < 3; ++ch) lobes.ch[ch] = emitChannel(raw.c[ch], emitted[ch], clampRemoved[ch]);
+  for (int ch = 0; ch < 3; ++ch)
+    lobes.ch[ch] = emitChannel(raw.c[ch], conductance[ch], emitted[ch], clampRemoved[ch]);
   sums.emitted += owned * emitted;
   sums.clampRemoved += owned * clampRemoved;
   sums.source += owned * vec3(raw.c[0].x, raw.c[1].x, raw.c[2].x);
   return lobes;
 }
 
-/// Halo vector h of slice z: lane l < HALF holds the cell left of the tile in row
-/// h * HALF + l, lane l >= HALF the cell right of it in row h * HALF + l - HALF.
-Cell fetchHalo(ivec2 origin, int lane, int h, int z) {
+/// Halo vector h: lane l < HALF holds the cell left of the tile in row h * HALF + l, lane
+/// l >= HALF the cell right of it in row h * HALF + l - HALF. Returns its (x, y).
+ivec2 haloCell(ivec2 origin, int lane, int h) {
   const int row = h * HALF + lane % HALF;
   const int x = lane < HALF ? origin.x - 1 : origin.x + W;
-  return fetchSource(x, row < ROWS ? origin.y + row : -1, z);  // rows past the tile: zero
+  return ivec2(x, row < ROWS ? origin.y + row : -1);  // rows past the tile: outside, zero
 }
 
 /// Applies the step factors to the light gathered into cell (x, y, z), writes it, and
@@ -85,9 +97,11 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
   const int i = cellIndex(x, y, z);
   const vec4 dc = texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i);
   const vec4 linear = texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 1);
+  const vec3 conductance = texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 4).xyz;
   const float on = dc.w;
   vec4 value[3];
   for (int ch = 0; ch < 3; ++ch) {
+    gathered.c[ch] *= conductance[ch];
     value[ch] = on * gathered.c[ch] * vec4(dc[ch], linear[ch], linear[ch], linear[ch]);
     destination[3 * i + ch] = value[ch];
     sums.gathered[ch] += on * gathered.c[ch].x;
@@ -133,7 +147,7 @@ void main() {
     [[unroll]] for (int r = 0; r < ROWS; ++r) current[r] = next[r] = later[r] = nothing();
     // Slice z0 - 1 only matters for the light it sends up into slice z0.
     [[unroll]] for (int r = 0; r < ROWS; ++r) {
-      const CellLobes lobes = emitCell(fetchSource(x, origin.y + r, z0 - 1), 0.0, sums);
+      const CellLobes lobes = emitCell(x, origin.y + r, z0 - 1, 0.0, sums);
       for (int ch = 0; ch < 3; ++ch) next[r].c[ch] += lobes.ch[ch].toward[PLUS_Z];
     }
     // Iteration z loads slice s = z + 1, whose light goes down into z, sideways within s
@@ -144,15 +158,16 @@ void main() {
       const int s = z + 1;
       const float owns = s < z1 && x < dims.x ? 1.0 : 0.0;
       // The halo rows send light into the tile's first and last rows.
-      const CellLobes haloBelow = emitCell(fetchSource(x, origin.y - 1, s), 0.0, sums);
-      const CellLobes haloAbove = emitCell(fetchSource(x, origin.y + ROWS, s), 0.0, sums);
+      const CellLobes haloBelow = emitCell(x, origin.y - 1, s, 0.0, sums);
+      const CellLobes haloAbove = emitCell(x, origin.y + ROWS, s, 0.0, sums);
       for (int ch = 0; ch < 3; ++ch) {
         next[0].c[ch] += haloBelow.ch[ch].toward[PLUS_Y];
         next[ROWS - 1].c[ch] += haloAbove.ch[ch].toward[MINUS_Y];
       }
       // The x halo columns send light into the tile's first and last lanes.
       [[unroll]] for (int h = 0; h < HALO_VECTORS; ++h) {
-        const CellLobes halo = emitCell(fetchHalo(origin, lane, h, s), 0.0, sums);
+        const ivec2 haloXY = haloCell(origin, lane, h);
+        const CellLobes halo = emitCell(haloXY.x, haloXY.y, s, 0.0, sums);
         for (int ch = 0; ch < 3; ++ch) {
           const vec4 inward = lane < HALF ? halo.ch[ch].toward[PLUS_X] : halo.ch[ch].toward[MINUS_X];
           [[unroll]] for (int k = 0; k < HALF; ++k) {
@@ -165,9 +180,11 @@ void main() {
         }
       }
       [[unroll]] for (int r = 0; r < ROWS; ++r) {
-        const CellLobes lobes = emitCell(fetchSource(x, origin.y + r, s), r < ROWS ? owns : 0.0, sums);
+        const CellLobes lobes = emitCell(x, origin.y + r, s, r < ROWS ? owns : 0.0, sums);
         // The boundary returns ρ per outside neighbour of what the cell sends one
-        // neighbour (its cells are isotropic in the calibrated scheme; 0 in the seed's).
+        // neighbour (its cells are isotropic in the calibrated scheme; 0 in the seed's);
+        // with a varying D, all the cell keeps, per conductance² (the lobes carry one
+        // factor, storeCell the other).
         const vec3 retention = fetchRetention(x, origin.y + r, s);
         for (int ch = 0; ch < 3; ++ch) {
           next[r].c[ch].x += retention[ch] * lobes.ch[ch].toward[PLUS_X].x;

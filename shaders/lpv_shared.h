@@ -36,8 +36,9 @@ namespace sslpv::gpu {
    (x) % SSLPV_TILE_X)
 
 /// vec4s of step factors per cell in the propagator's factor grid: (dc.rgb, active),
-/// (linear.rgb, 0), (retention.rgb, 0), (freshGain.rgb, 0) (StepFactors).
-#define SSLPV_FACTOR_VEC4_PER_CELL 4
+/// (linear.rgb, 0), (retention.rgb, 0), (freshGain.rgb, 0), (conductance.rgb, 0)
+/// (StepFactors).
+#define SSLPV_FACTOR_VEC4_PER_CELL 5
 
 /// Push constants of the propagation step, the per-step reduction and the accumulation.
 #define SSLPV_LPV_STEP_PUSH_FIELDS(X)                                                       \

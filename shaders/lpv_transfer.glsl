@@ -33,8 +33,9 @@ struct Lobes {
 };
 
 /// Normalizes one channel `c` of a source cell (normalizeEmission on the CPU) and returns
-/// the lobes it sends. Adds the power it holds and the excess the clamp would have created.
-Lobes emitChannel(vec4 c, inout float emitted, inout float clampRemoved) {
+/// the lobes it sends, times the cell's `conductance` (StepFactors::conductance; 1 where
+/// D is uniform). Adds the power it holds and the excess the clamp would have created.
+Lobes emitChannel(vec4 c, float conductance, inout float emitted, inout float clampRemoved) {
   const float base = c.x * kY00;
   float total = 0.0;
   vec4 axisFrame[6];  // (dc, along the axis, along b1, along b2), unscaled
@@ -60,7 +61,7 @@ Lobes emitChannel(vec4 c, inout float emitted, inout float clampRemoved) {
   // nothing, and what its lobe would have sent counts as removed, as on the CPU.
   const float power = max(0.0, c.x * kFluxPerC0);
   const float raw = total;
-  const float scale = raw > 0.0 ? power / raw : 0.0;
+  const float scale = (raw > 0.0 ? power / raw : 0.0) * conductance;
   emitted += power;
   clampRemoved += max(0.0, raw - power);
   // Back to (c0, x, y, z): along x, b1 = y and b2 = z; along y, b1 = z and b2 = x; along

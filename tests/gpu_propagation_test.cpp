@@ -271,6 +271,8 @@ TEST_F(GpuPropagation, CalibratedSphereAndShellWithBoundaryRetentionMatchCpu) {
       for (int k = 1; k < 4; ++k) std::fill(c.injected.plane(ch, k), c.injected.plane(ch, k) + c.material.frame.cellCount(), 0.0f);
     const StepFactors factors = computeStepFactors(c.material, LpvScheme::Calibrated, 1.4);
     ASSERT_GT(*std::max_element(factors.retention[0].begin(), factors.retention[0].end()), 0.0f);
+    // σt' varies from cell to cell, so faces pass light at per-cell conductances too.
+    ASSERT_FALSE(factors.conductance[0].empty());
     // Near its poles the sphere's faces are aligned and inside their cells: the injected
     // light enters the accumulated light with a fresh gain there (gridPhaseFreshGain).
     const auto [lowGain, highGain] = std::minmax_element(factors.freshGain[0].begin(), factors.freshGain[0].end());

@@ -73,6 +73,19 @@
 //     (Lambertian inside, Fresnel-weighted outside): the shading weights each cell's
 //     exitant radiance by the half-space's exit shape for its α' and η, normalised to
 //     the same total power (volume/exit_law.h).
+//  7. Gives a heterogeneous medium its own diffusion coefficient per cell. Points 1-6 fix
+//     the walk's decay κ per cell, but every cell passes light on at the same rate, so
+//     the lattice solves ∇·(D_L ∇φ) − D_L σtr² φ with one D_L: where σt' varies, the
+//     flux through an interface is wrong (a marble slab with a 2 mm vein of half the
+//     σs' and 100x the σa: diffusion theory puts the lattice's transmission at x1.48 of
+//     the medium's; a sheet of marble's σs' and the vein's σa at x0.91). With D = 1/(3σt')
+//     and w = D / D_ref, each face passes √(w_i w_j) of what it passed and the cell keeps
+//     the rest, which gives ∇·(w D_L ∇φ). In a homogeneous region this is the same
+//     lattice run slower: with the survival 1/s_w − 1 = w (1/s − 1), the accumulated
+//     light is exactly λ = 1 + s (1/w − 1) times the w = 1 lattice's (boundary and fresh
+//     light included), so the exit gain is divided by λ and the fresh gain F becomes
+//     1 + λ (F − 1). D_ref is the largest D of the grid's cells, but at most
+//     kMaxDiffusivityContrast times the smallest: steps grow as 1 / w.
 //
 // Keeping the seed scheme selectable lets the benchmark show both.
 #include <array>

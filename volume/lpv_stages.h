@@ -118,7 +118,14 @@ struct StepFactors {
   /// neighbours that are outside the object: each step a boundary cell keeps that many
   /// times ρ of what it sends one neighbour (isotropic cells send each neighbour 1/6).
   /// Empty in the seed scheme, whose boundary loses everything sent across it.
+  /// Where `conductance` is set, it is everything the cell keeps each step (the boundary's
+  /// return and the hold of varyDiffusivity) in the same unit, divided by conductance².
   std::array<std::vector<float>, 3> retention;
+  /// Calibrated scheme with a spatially varying diffusion coefficient: per channel, per
+  /// cell, sqrt(D / D_ref); light crossing the face between cells i and j is weighted by
+  /// conductance[i] · conductance[j] (lpv_calibration.h, point 7). Empty (all 1) when the
+  /// medium's D is uniform, and in the seed scheme.
+  std::array<std::vector<float>, 3> conductance;
   /// Calibrated scheme: per channel, per cell, the gain on the injected light as it enters
   /// the accumulated light (gridPhaseFreshGain; 1 away from aligned faces that fall inside
   /// their cells). The propagation carries the injected light unscaled. Empty in the seed
@@ -140,6 +147,22 @@ struct StepFactors {
 };
 StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme = LpvScheme::Seed,
                                double ior = 1.0);
+
+/// Beyond this ratio between the largest and the smallest diffusion coefficient of a
+/// grid's cells (per channel), the densest cells pass light faster than their own D: the
+/// propagation's step count grows as the ratio (lpv_calibration.h, point 7).
+constexpr double kMaxDiffusivityContrast = 8.0;
+
+/// Per channel, per active cell, sqrt(D / D_ref) of the calibrated scheme's lattice
+/// (StepFactors::conductance); empty arrays when every cell's is 1.
+std::array<std::vector<float>, 3> diffusivityConductance(const MaterialGrid& material, const StepFactors& factors);
+
+/// Makes calibrated `factors` (conductance still empty) pass light through each face at
+/// conductance[i] · conductance[j] of the rate they were computed for, keeping each
+/// homogeneous region's accumulated light, as read through the exit and fresh gains,
+/// what it was (lpv_calibration.h, point 7). Values in (0, 1].
+void applyConductance(const MaterialGrid& material, std::array<std::vector<float>, 3> conductance,
+                      StepFactors& factors);
 
 /// Whether a propagation on `frame` with `options` runs any step (a grid under 3 cells
 /// along an axis, or a step limit of 0, only accumulates the injected light).

@@ -102,12 +102,13 @@ struct Gathered {
 
 /// Adds what the neighbour at `j` sends through the 5 faces of the destination when light
 /// travels along SD * e_A: the front face re-emits along e_A, the side faces along ±e_B.
+/// `weight`: the sender's conductance (StepFactors::conductance; 1 where D is uniform).
 template <int A, int SD>
 inline void gatherFrom(const float* __restrict c0, const float* __restrict cx, const float* __restrict cy,
-                       const float* __restrict cz, std::size_t j, Gathered& out) {
+                       const float* __restrict cz, std::size_t j, float weight, Gathered& out) {
   constexpr int B1 = (A + 1) % 3, B2 = (A + 2) % 3;
-  const float c1[3] = {cx[j], cy[j], cz[j]};
-  const float base = c0[j] * sh::kY00;
+  const float c1[3] = {weight * cx[j], weight * cy[j], weight * cz[j]};
+  const float base = weight * c0[j] * sh::kY00;
   const float along = (SD * sh::kY1) * c1[A];
   const float front = std::max(0.0f, base + along);
   const float alongSide = base + along * kSideNorm;
@@ -124,9 +125,11 @@ inline void gatherFrom(const float* __restrict c0, const float* __restrict cx, c
 /// One gather into dst for the interior rows of slice z; applies the step factors,
 /// accumulates, and records the slice's power sums. All six neighbours are read in one
 /// pass over the row so each output is written once.
-/// kRetain: the calibrated scheme's boundary retention (a template parameter so that the
-/// seed scheme's loop carries no test in its body).
-template <bool kRetain>
+/// kRetain: the calibrated scheme's boundary retention, kConduct: its varying diffusion
+/// coefficient (template parameters so that the seed scheme's loop carries no test in its
+/// body). Each face passes conductance[i] · conductance[j]: the sender's factor is applied
+/// as it sends, the receiver's to all it gathers, as lpv_propagate.comp does.
+template <bool kRetain, bool kConduct>
 void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& dst, ShGrid& accumulated,
                  SliceSums& s) {
   const GridFrame& f = src.frame;
@@ -145,6 +148,7 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
       const float* __restrict lin = factors.linear[ch].data();
       const unsigned char* __restrict active = factors.active.data();
       const float* __restrict retain = kRetain ? factors.retention[ch].data() : nullptr;
+      const float* __restrict conduct = kConduct ? factors.conductance[ch].data() : nullptr;
       float* __restrict out[4] = {dst.plane(ch, 0), dst.plane(ch, 1), dst.plane(ch, 2), dst.plane(ch, 3)};
       float* __restrict sum[4] = {accumulated.plane(ch, 0), accumulated.plane(ch, 1), accumulated.plane(ch, 2),
                                   accumulated.plane(ch, 3)};
@@ -152,17 +156,24 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
 #pragma omp simd reduction(+ : gathered, absorbed, kept)
       for (int x = 0; x < row; ++x) {
         const std::size_t i = rowStart + x;
+        const auto weight = [&](std::size_t j) { return kConduct ? conduct[j] : 1.0f; };
         Gathered g;
-        gatherFrom<0, +1>(c0, cx, cy, cz, i - sx, g);
-        gatherFrom<0, -1>(c0, cx, cy, cz, i + sx, g);
-        gatherFrom<1, +1>(c0, cx, cy, cz, i - sy, g);
-        gatherFrom<1, -1>(c0, cx, cy, cz, i + sy, g);
-        gatherFrom<2, +1>(c0, cx, cy, cz, i - sz, g);
-        gatherFrom<2, -1>(c0, cx, cy, cz, i + sz, g);
+        gatherFrom<0, +1>(c0, cx, cy, cz, i - sx, weight(i - sx), g);
+        gatherFrom<0, -1>(c0, cx, cy, cz, i + sx, weight(i + sx), g);
+        gatherFrom<1, +1>(c0, cx, cy, cz, i - sy, weight(i - sy), g);
+        gatherFrom<1, -1>(c0, cx, cy, cz, i + sy, weight(i + sy), g);
+        gatherFrom<2, +1>(c0, cx, cy, cz, i - sz, weight(i - sz), g);
+        gatherFrom<2, -1>(c0, cx, cy, cz, i + sz, weight(i + sz), g);
         const float on = active[i] ? 1.0f : 0.0f;
         // The boundary's share of what this cell sent toward outside neighbours: the DC an
-        // isotropic cell sends one neighbour, times ρ per outside neighbour.
-        if constexpr (kRetain) g.c0 += retain[i] * (kEmitDC * (kFront + 4.0f * kSide) * sh::kY00) * c0[i];
+        // isotropic cell sends one neighbour, times ρ per outside neighbour (with a varying
+        // D, all the cell keeps, per its conductance²: the cell sends conductance · c0).
+        if constexpr (kRetain)
+          g.c0 += retain[i] * (kEmitDC * (kFront + 4.0f * kSide) * sh::kY00) * (weight(i) * c0[i]);
+        if constexpr (kConduct) {
+          g.c0 *= conduct[i];
+          for (float& c : g.c) c *= conduct[i];
+        }
         const float v0 = on * g.c0 * dc[i];
         const float v1 = on * g.c[0] * lin[i], v2 = on * g.c[1] * lin[i], v3 = on * g.c[2] * lin[i];
         out[0][i] = v0;
@@ -287,16 +298,19 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
   next.resize(f);
   std::vector<SliceSums> sums(f.dims.z);
   const bool retain = !factors.retention[0].empty();
+  const bool conduct = !factors.conductance[0].empty();
   for (int step = 0; step < maxSteps; ++step) {
     std::fill(sums.begin(), sums.end(), SliceSums{});
     normalizeEmission(factors, field, sums);
     tbb::parallel_for(tbb::blocked_range<int>(1, f.dims.z - 1), [&](const tbb::blocked_range<int>& zs) {
       FlushDenormals flush;
       for (int z = zs.begin(); z < zs.end(); ++z) {
-        if (retain)
-          gatherSlice<true>(z, factors, field, next, accumulated, sums[z]);
+        if (conduct)
+          gatherSlice<true, true>(z, factors, field, next, accumulated, sums[z]);
+        else if (retain)
+          gatherSlice<true, false>(z, factors, field, next, accumulated, sums[z]);
         else
-          gatherSlice<false>(z, factors, field, next, accumulated, sums[z]);
+          gatherSlice<false, false>(z, factors, field, next, accumulated, sums[z]);
       }
     });
     std::swap(field.planes, next.planes);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "volume/lpv_stages.h"
@@ -336,8 +337,76 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
     limitExitGainToNeighbours(material, factors);
     correctStaircaseExit(material, freshShare, factors);
     correctGridPhase(material, extrapolation, factors);
+    std::array<std::vector<float>, 3> conductance = diffusivityConductance(material, factors);
+    if (!conductance[0].empty()) applyConductance(material, std::move(conductance), factors);
   }
   return factors;
+}
+
+std::array<std::vector<float>, 3> diffusivityConductance(const MaterialGrid& material, const StepFactors& factors) {
+  const std::size_t n = material.frame.cellCount();
+  std::array<std::vector<float>, 3> conductance;
+  bool uniform = true;
+  for (int ch = 0; ch < 3; ++ch) {
+    // The diffusion coefficient in units of 1/3: 1/σt' (an empty cell's is infinite).
+    std::vector<double> diffusivity(n, 0.0);
+    double smallest = std::numeric_limits<double>::infinity(), largest = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!factors.active[i]) continue;
+      const double reducedT = double(material.sigmaT[i][ch]) - double(material.sigmaS[i][ch]) * material.g[i];
+      diffusivity[i] = reducedT > 0.0 ? 1.0 / reducedT : std::numeric_limits<double>::infinity();
+      smallest = std::min(smallest, diffusivity[i]);
+      largest = std::max(largest, diffusivity[i]);
+    }
+    const double reference = std::min(largest, kMaxDiffusivityContrast * smallest);
+    conductance[ch].assign(n, 1.0f);
+    if (!(reference > 0.0) || !std::isfinite(smallest)) continue;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!factors.active[i]) continue;
+      const float root = float(std::sqrt(std::min(1.0, diffusivity[i] / reference)));
+      conductance[ch][i] = root;
+      if (root < 1.0f) uniform = false;
+    }
+  }
+  if (uniform)
+    for (auto& c : conductance) c.clear();
+  return conductance;
+}
+
+void applyConductance(const MaterialGrid& material, std::array<std::vector<float>, 3> conductance,
+                      StepFactors& factors) {
+  const GridFrame& f = material.frame;
+  for (int ch = 0; ch < 3; ++ch) {
+    const std::vector<float>& c = conductance[ch];
+    tbb::parallel_for(0, f.dims.z, [&](int z) {
+      for (int y = 0; y < f.dims.y; ++y)
+        for (int x = 0; x < f.dims.x; ++x) {
+          const std::size_t i = f.index(x, y, z);
+          if (!factors.active[i]) continue;
+          const double w = double(c[i]) * c[i];
+          // What the cell keeps, in units of what an isotropic cell sends one neighbour:
+          // the share each face no longer passes, plus the boundary's return, which
+          // outside faces (conductance w, the cell's own) now apply to w of it.
+          double hold = w * factors.retention[ch][i];
+          for (int axis = 0; axis < 3; ++axis)
+            for (int d = -1; d <= 1; d += 2) {
+              glm::ivec3 other(x, y, z);
+              other[axis] += d;
+              // Active cells never touch the grid's edge, so the neighbour exists.
+              const std::size_t j = f.index(other.x, other.y, other.z);
+              hold += 1.0 - (factors.active[j] ? double(c[i]) * c[j] : w);
+            }
+          factors.retention[ch][i] = float(hold / w);
+          const double survival = factors.dc[ch][i];
+          if (!(survival > 0.0)) continue;  // absorbs everything in one step at any rate
+          const double scale = 1.0 + survival * (1.0 / w - 1.0);  // λ
+          factors.dc[ch][i] = float(1.0 / (1.0 + w * (1.0 / survival - 1.0)));
+          factors.exitGain[ch][i] = float(factors.exitGain[ch][i] / scale);
+          factors.freshGain[ch][i] = float(1.0 + scale * (factors.freshGain[ch][i] - 1.0));
+        }
+    });
+  }
+  factors.conductance = std::move(conductance);
 }
 
 }  // namespace sslpv
