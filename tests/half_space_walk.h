@@ -46,4 +46,52 @@ inline double halfSpaceWalk(double albedo, double eta, int photons, std::uint64_
   return p;
 }
 
+/// What a slab `thickness` mean free paths thick (σt = 1), with the same boundary on both
+/// faces, reflects and transmits of a collimated beam along the normal: the analog walk
+/// above with a second face. Light leaving through the far face without having scattered
+/// (the beam's unscattered remainder) is counted apart, as `direct`.
+struct SlabWalk {
+  double reflected = 0.0, transmitted = 0.0, direct = 0.0;
+  double reflectedError = 0.0, transmittedError = 0.0;
+};
+inline SlabWalk slabWalk(double albedo, double eta, double thickness, int photons, std::uint64_t seed) {
+  ReferenceRng rng(seed, 0, 0);
+  const double f0 = fresnelReflectance(1.0, eta);
+  long long reflected = 0, transmitted = 0, direct = 0;
+  for (int k = 0; k < photons; ++k) {
+    if (rng.uniform() < f0) continue;
+    double z = 0.0, mu = 1.0;
+    bool scattered = false;
+    while (true) {
+      z -= std::log(1.0 - rng.uniform()) * mu;
+      if (z < 0.0 || z > thickness) {
+        const double sin2T = eta * eta * (1.0 - mu * mu);
+        const double reflect = sin2T >= 1.0 ? 1.0 : fresnelReflectance(std::sqrt(1.0 - sin2T), eta);
+        if (rng.uniform() < reflect) {
+          z = z < 0.0 ? 0.0 : thickness;
+          mu = -mu;
+          continue;
+        }
+        if (z < 0.0)
+          ++reflected;
+        else if (scattered)
+          ++transmitted;
+        else
+          ++direct;
+        break;
+      }
+      if (rng.uniform() >= albedo) break;
+      mu = 1.0 - 2.0 * rng.uniform();
+      scattered = true;
+    }
+  }
+  SlabWalk w;
+  w.reflected = double(reflected) / photons;
+  w.transmitted = double(transmitted) / photons;
+  w.direct = double(direct) / photons;
+  w.reflectedError = std::sqrt(w.reflected * (1.0 - w.reflected) / photons);
+  w.transmittedError = std::sqrt(w.transmitted * (1.0 - w.transmitted) / photons);
+  return w;
+}
+
 }  // namespace sslpv::test

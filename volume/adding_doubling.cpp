@@ -215,6 +215,40 @@ void thinLayer(double albedo, const std::vector<double>& mu, const std::vector<d
   }
 }
 
+/// Puts two copies of a layer (r, t: its diffuse matrices; r0, t0: the beam's diffusely
+/// reflected and transmitted columns; direct: the beam's unscattered fraction) one on the
+/// other, in place. Between them the downward power d and the upward power u satisfy
+/// d = (from above) + R u and u = R d + (from below), hence (I - R R)^-1. The beam: the
+/// upper copy passes `direct` of it unscattered and t0 scattered downward; the lower copy
+/// reflects the unscattered part as direct * r0.
+void doubleLayer(Matrix& r, Matrix& t, std::vector<double>& r0, std::vector<double>& t0, double& direct) {
+  const int n = r.n;
+  Matrix a(n), x(n), tr(n), next(n);
+  multiply(r, r, a);
+  for (double& v : a.a) v = -v;
+  for (int i = 0; i < n; ++i) a(i, i) += 1.0;
+  const Lu lu(a);
+  std::vector<double> d = multiply(r, r0);
+  for (int i = 0; i < n; ++i) d[std::size_t(i)] = t0[std::size_t(i)] + direct * d[std::size_t(i)];
+  lu.solve(d);
+  std::vector<double> u = multiply(r, d);
+  for (int i = 0; i < n; ++i) u[std::size_t(i)] += direct * r0[std::size_t(i)];
+  const std::vector<double> reflectedBack = multiply(t, u), passedDown = multiply(t, d);
+  for (int i = 0; i < n; ++i) {
+    r0[std::size_t(i)] += reflectedBack[std::size_t(i)];
+    t0[std::size_t(i)] = passedDown[std::size_t(i)] + direct * t0[std::size_t(i)];
+  }
+  direct *= direct;
+
+  x = t;
+  lu.solve(x);  // (I - R R)^-1 T
+  multiply(t, r, tr);
+  multiply(tr, x, next);
+  for (std::size_t k = 0; k < r.a.size(); ++k) r.a[k] += next.a[k];
+  multiply(t, x, next);
+  std::swap(t.a, next.a);
+}
+
 }  // namespace
 
 HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const AddingDoublingOptions& options) {
@@ -246,37 +280,10 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
   thinLayer(albedo, mu, w, mu0, delta, r, t, r0, t0);
   double direct = std::exp(-delta / mu0);  // the beam's unscattered fraction
 
-  Matrix a(n), x(n), tr(n), next(n);
   double thickness = delta;
   double transmittance = 1.0;
   while (true) {
-    // Two copies of the layer, one on the other. Between them the downward power d and
-    // the upward power u satisfy d = (from above) + R u and u = R d + (from below), hence
-    // (I - R R)^-1. The beam: the upper copy passes `direct` of it unscattered and t0
-    // scattered downward; the lower copy reflects the unscattered part as direct * r0.
-    multiply(r, r, a);
-    for (double& v : a.a) v = -v;
-    for (int i = 0; i < n; ++i) a(i, i) += 1.0;
-    const Lu lu(a);
-    std::vector<double> d = multiply(r, r0);
-    for (int i = 0; i < n; ++i) d[std::size_t(i)] = t0[std::size_t(i)] + direct * d[std::size_t(i)];
-    lu.solve(d);
-    std::vector<double> u = multiply(r, d);
-    for (int i = 0; i < n; ++i) u[std::size_t(i)] += direct * r0[std::size_t(i)];
-    const std::vector<double> reflectedBack = multiply(t, u), passedDown = multiply(t, d);
-    for (int i = 0; i < n; ++i) {
-      r0[std::size_t(i)] += reflectedBack[std::size_t(i)];
-      t0[std::size_t(i)] = passedDown[std::size_t(i)] + direct * t0[std::size_t(i)];
-    }
-    direct *= direct;
-
-    x = t;
-    lu.solve(x);  // (I - R R)^-1 T
-    multiply(t, r, tr);
-    multiply(tr, x, next);
-    for (std::size_t k = 0; k < r.a.size(); ++k) r.a[k] += next.a[k];
-    multiply(t, x, next);
-    std::swap(t.a, next.a);
+    doubleLayer(r, t, r0, t0, direct);
     thickness *= 2.0;
     ++result.doublings;
 
@@ -296,6 +303,7 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
   // which the half-space reflects again: u = (1 - F(θi)) r0 + R F u.
   std::vector<double> fresnel(bins);
   for (int i = 0; i < n; ++i) fresnel[std::size_t(i)] = internalFresnel(mu[std::size_t(i)], eta);
+  Matrix a(n);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) a(i, j) = (i == j ? 1.0 : 0.0) - r(i, j) * fresnel[std::size_t(j)];
   std::vector<double> u = r0;
@@ -308,6 +316,71 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
     result.exitFlux[std::size_t(i)] = (1.0 - fresnel[std::size_t(i)]) * u[std::size_t(i)];
     result.rd += result.exitFlux[std::size_t(i)];
   }
+  return result;
+}
+
+SlabTransport addingDoublingSlab(double albedo, double eta, double thickness, const AddingDoublingOptions& options) {
+  if (!(albedo >= 0.0 && albedo <= 1.0)) throw std::invalid_argument("addingDoublingSlab: albedo must be in [0, 1]");
+  if (!(eta > 0.0) || !std::isfinite(eta)) throw std::invalid_argument("addingDoublingSlab: eta must be positive");
+  if (!(thickness > 0.0) || !std::isfinite(thickness))
+    throw std::invalid_argument("addingDoublingSlab: thickness must be positive");
+  if (options.nodes < 2) throw std::invalid_argument("addingDoublingSlab: need at least 2 nodes");
+  const double mu0 = options.beamCosine;
+  const double sin2Outside = eta * eta * (1.0 - mu0 * mu0);
+  if (!(mu0 > 0.0 && mu0 <= 1.0) || !(sin2Outside < 1.0))
+    throw std::invalid_argument("addingDoublingSlab: no beam from outside refracts to that beam cosine");
+  std::vector<double> mu, w;
+  boundaryQuadrature(options.nodes, eta, mu, w);
+  const int n = int(mu.size());
+  const std::size_t bins = mu.size();
+  // thickness / 2^k, small enough for the starting layer (as the half-space's), doubled k times.
+  const double muMin = std::min(mu0, *std::min_element(mu.begin(), mu.end()));
+  int doublings = 0;
+  double delta = thickness;
+  while (delta > 0.5 * muMin) {
+    delta *= 0.5;
+    ++doublings;
+  }
+  Matrix r(n), t(n);
+  std::vector<double> r0(bins), t0(bins);
+  thinLayer(albedo, mu, w, mu0, delta, r, t, r0, t0);
+  double direct = std::exp(-delta / mu0);
+  for (int k = 0; k < doublings; ++k) doubleLayer(r, t, r0, t0, direct);
+
+  // Both faces reflect F(μ) of what reaches them from inside back into the same bin. With u
+  // the upward power arriving at the top face and d the downward power at the bottom one:
+  //   u = e r0 + R F u + T F d,   d = e t0 + T F u + R F d,   e = 1 - F(θi) entering.
+  // The beam's unscattered remainder reaches the bottom face, which reflects F(μ0) of it
+  // back up as a beam; by the slab's symmetry that beam sends t0 of itself up and r0 down.
+  // What of it crosses the whole slab again unscattered is dropped (e^-2 thickness).
+  std::vector<double> fresnel(bins);
+  for (int i = 0; i < n; ++i) fresnel[std::size_t(i)] = internalFresnel(mu[std::size_t(i)], eta);
+  const double entering = 1.0 - fresnelReflectance(std::sqrt(1.0 - sin2Outside), eta);
+  const double backBeam = internalFresnel(mu0, eta) * direct;  // per unit entering power
+  Matrix system(2 * n);
+  std::vector<double> rhs(std::size_t(2 * n));
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const double fj = fresnel[std::size_t(j)];
+      system(i, j) = (i == j ? 1.0 : 0.0) - r(i, j) * fj;
+      system(i, n + j) = -t(i, j) * fj;
+      system(n + i, j) = -t(i, j) * fj;
+      system(n + i, n + j) = (i == j ? 1.0 : 0.0) - r(i, j) * fj;
+    }
+    rhs[std::size_t(i)] = entering * (r0[std::size_t(i)] + backBeam * t0[std::size_t(i)]);
+    rhs[std::size_t(n + i)] = entering * (t0[std::size_t(i)] + backBeam * r0[std::size_t(i)]);
+  }
+  Lu(system).solve(rhs);
+  SlabTransport result;
+  result.transmittedFlux.resize(bins);
+  for (int i = 0; i < n; ++i) {
+    result.rd += (1.0 - fresnel[std::size_t(i)]) * rhs[std::size_t(i)];
+    result.transmittedFlux[std::size_t(i)] = (1.0 - fresnel[std::size_t(i)]) * rhs[std::size_t(n + i)];
+    result.td += result.transmittedFlux[std::size_t(i)];
+  }
+  result.mu = std::move(mu);
+  result.weight = std::move(w);
+  result.direct = entering * direct * (1.0 - internalFresnel(mu0, eta));
   return result;
 }
 

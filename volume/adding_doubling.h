@@ -71,6 +71,27 @@ struct HalfSpaceReflectance {
 /// (0, 1] that no beam from outside refracts into.
 HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const AddingDoublingOptions& options = {});
 
+struct SlabTransport {
+  double rd = 0.0;      ///< diffusely reflected power per unit incident power (entry loss included)
+  double td = 0.0;      ///< diffusely transmitted power through the far face, per unit incident power
+  double direct = 0.0;  ///< the beam's unscattered power leaving through the far face, per unit incident power
+  std::vector<double> mu;      ///< quadrature nodes: direction cosines inside the medium
+  std::vector<double> weight;  ///< their weights, summing to 1 over [0, 1]
+  /// Diffuse power leaving through the far face from each node's bin, per unit incident
+  /// power (sums to td); the radiance outside along node i's refracted direction is
+  /// π L / E = transmittedFlux[i] / (2 weight[i] mu[i] η²), as for HalfSpaceReflectance.
+  std::vector<double> transmittedFlux;
+};
+
+/// A slab of optical thickness `thickness` (mean free paths, σt = 1) of the same medium as
+/// addingDoublingHalfSpace, with the same smooth boundary on both faces, lit by the beam on
+/// one face: what it reflects and what it transmits diffusely. The slab is thickness / 2^k
+/// doubled k times, so any thickness is exact; the beam the far face reflects back is
+/// followed until it scatters (what of it crosses the slab twice unscattered, a share
+/// e^-2thickness, is dropped). Throws std::invalid_argument like
+/// addingDoublingHalfSpace, and for a non-positive or non-finite thickness.
+SlabTransport addingDoublingSlab(double albedo, double eta, double thickness, const AddingDoublingOptions& options = {});
+
 /// Fraction of the power of a Lambertian (uniform-radiance) field inside a medium of
 /// relative index `eta` that crosses its smooth boundary: 1 minus the internal diffuse
 /// Fresnel reflectance, total internal reflection included; = (1 - F̄_outside) / η².
