@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "bench/image_mean.h"
+#include "bench/slab_scene.h"
 #include "volume/cpu_renderer.h"
 #include "volume/lpv_calibration.h"
 #include "volume/material.h"
@@ -32,17 +33,9 @@ namespace {
 using namespace sslpv;
 
 Scene slabScene(const MeasuredMaterial& material, double ior) {
-  Scene scene;
-  scene.units = "mm";
-  scene.mesh.kind = MeshSource::Kind::Box;
   // 200 x 200 x 100 mm: 5.5 diffusion lengths of the most diffusive channel (skim milk
   // red, 1/σtr = 18 mm) from the middle of the top face to the sides and the bottom.
-  scene.mesh.boxMin = glm::dvec3(-100.0, -100.0, -100.0);
-  scene.mesh.boxMax = glm::dvec3(100.0, 100.0, 0.0);
-  scene.material.base.sigmaT = material.sigmaSPrime + material.sigmaA;
-  scene.material.base.sigmaS = material.sigmaSPrime;
-  scene.material.base.g = 0.0f;
-  scene.material.ior = ior;
+  Scene scene = bench::materialBox(material, ior, glm::dvec3(-100.0, -100.0, -100.0), glm::dvec3(100.0, 100.0, 0.0));
   Light light;
   light.type = Light::Type::Directional;
   light.direction = glm::dvec3(0.0, 0.0, -1.0);
@@ -75,8 +68,7 @@ int main(int argc, char** argv) {
     } else if (arg == "--ior" && hasValue) {
       jensenIor = std::string(argv[++i]) != "1";
     } else if (arg == "--materials" && hasValue) {
-      std::stringstream list(argv[++i]);
-      for (std::string name; std::getline(list, name, ',');) only.push_back(name);
+      only = bench::splitNames(argv[++i]);
     } else {
       std::fprintf(stderr, "usage: slab_calibration [--grid N] [--spp N] [--ior jensen|1] [--materials a,b]\n");
       return 2;
@@ -96,10 +88,7 @@ int main(int argc, char** argv) {
     const ReferenceResult truth = ReferenceTracer(scene).render(options);
     const glm::dvec3 reference = meanReflectance(truth.radiance);
     const glm::dvec3 error = meanReflectance(truth.standardError) / 4.0;  // 16 pixels: SE / sqrt(16)
-    LpvSettings settings;
-    settings.resolution = grid;
-    settings.autoSteps = true;
-    settings.scheme = LpvScheme::Calibrated;
+    LpvSettings settings = bench::calibratedAuto(grid);
     const glm::dvec3 calibrated = meanReflectance(CpuRenderer(scene).render(settings));
     settings.scheme = LpvScheme::Seed;
     const glm::dvec3 seed = meanReflectance(CpuRenderer(scene).render(settings));

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bench/image_mean.h"
+#include "bench/slab_scene.h"
 #include "volume/cpu_renderer.h"
 #include "volume/material.h"
 #include "volume/reference_tracer.h"
@@ -32,16 +33,8 @@ struct Orientation {
 /// the sides, the most diffusive channel here), top face through the origin; a 3-degree
 /// view of its middle along the normal, so every pixel sees the same depth profile.
 Scene slabScene(const MeasuredMaterial& material, const Orientation& o) {
-  Scene scene;
-  scene.units = "mm";
-  scene.mesh.kind = MeshSource::Kind::Box;
-  scene.mesh.boxMin = glm::dvec3(-30.0, -30.0, -30.0);
-  scene.mesh.boxMax = glm::dvec3(30.0, 0.0, 30.0);
+  Scene scene = bench::materialBox(material, material.eta, glm::dvec3(-30.0, -30.0, -30.0), glm::dvec3(30.0, 0.0, 30.0));
   scene.transform.rotateDeg = o.tiltDeg;
-  scene.material.base.sigmaT = material.sigmaSPrime + material.sigmaA;
-  scene.material.base.sigmaS = material.sigmaSPrime;
-  scene.material.base.g = 0.0f;
-  scene.material.ior = material.eta;
   const glm::dmat4 rotation = scene.transform.matrix();
   const glm::dvec3 normal = glm::normalize(glm::dvec3(rotation * glm::dvec4(0, 1, 0, 0)));
   const glm::dvec3 along = glm::normalize(glm::dvec3(rotation * glm::dvec4(1, 0, 0, 0)));
@@ -72,9 +65,7 @@ int main(int argc, char** argv) {
     } else if (arg == "--spp" && hasValue) {
       spp = std::atoi(argv[++i]);
     } else if (arg == "--materials" && hasValue) {
-      only.clear();
-      std::stringstream list(argv[++i]);
-      for (std::string name; std::getline(list, name, ',');) only.push_back(name);
+      only = bench::splitNames(argv[++i]);
     } else {
       std::fprintf(stderr, "usage: slab_orientation [--grid N] [--spp N] [--materials a,b]\n");
       return 2;
@@ -103,11 +94,7 @@ int main(int argc, char** argv) {
       const glm::dvec3 reference = bench::meanRadiance(truth.radiance);
       // Pixels are independent: the mean's standard error is the pixels' over sqrt(1024).
       const glm::dvec3 error = bench::meanRadiance(truth.standardError) / 32.0;
-      LpvSettings settings;
-      settings.resolution = grid;
-      settings.autoSteps = true;
-      settings.scheme = LpvScheme::Calibrated;
-      const glm::dvec3 lpv = bench::meanRadiance(CpuRenderer(scene).render(settings));
+      const glm::dvec3 lpv = bench::meanRadiance(CpuRenderer(scene).render(bench::calibratedAuto(grid)));
       const glm::dvec3 ratio = lpv / reference;
       const double worstSe = std::max({error.x / reference.x, error.y / reference.y, error.z / reference.z});
       std::printf("%-9s %-14s %7.3f %7.3f %7.3f %8.2f%%\n", std::string(material.name).c_str(), o.name, ratio.x,
