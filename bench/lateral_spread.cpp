@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -84,24 +83,11 @@ std::vector<RingSums> ringSums(const Image& lpv, const ReferenceResult& truth) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int grid = 100, spp = 64, size = 128;
-  std::vector<std::string> only = {"ketchup", "skin1", "marble"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const bool hasValue = i + 1 < argc;
-    if (arg == "--grid" && hasValue) {
-      grid = std::atoi(argv[++i]);
-    } else if (arg == "--spp" && hasValue) {
-      spp = std::atoi(argv[++i]);
-    } else if (arg == "--size" && hasValue) {
-      size = std::atoi(argv[++i]);
-    } else if (arg == "--materials" && hasValue) {
-      only = bench::splitNames(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: lateral_spread [--grid N] [--spp N] [--size N] [--materials a,b]\n");
-      return 2;
-    }
-  }
+  const bench::Flags flags(argc, argv, {"grid", "spp", "size", "materials"},
+                           "lateral_spread [--grid N] [--spp N] [--size N] [--materials a,b]");
+  if (!flags.ok()) return 2;
+  const int grid = flags.integer("grid", 100), spp = flags.integer("spp", 64), size = flags.integer("size", 128);
+  const std::vector<std::string> only = flags.names("materials", {"ketchup", "skin1", "marble"});
   if (grid < 8 || spp < 1 || size < 16) {
     std::fprintf(stderr, "lateral_spread: need --grid >= 8, --spp >= 1, --size >= 16\n");
     return 2;

@@ -15,7 +15,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -55,25 +54,12 @@ glm::dvec3 meanReflectance(const Image& image) { return M_PI * bench::meanRadian
 }  // namespace
 
 int main(int argc, char** argv) {
-  int grid = 64, spp = 256;
-  bool jensenIor = true;
-  std::vector<std::string> only;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const bool hasValue = i + 1 < argc;
-    if (arg == "--grid" && hasValue) {
-      grid = std::atoi(argv[++i]);
-    } else if (arg == "--spp" && hasValue) {
-      spp = std::atoi(argv[++i]);
-    } else if (arg == "--ior" && hasValue) {
-      jensenIor = std::string(argv[++i]) != "1";
-    } else if (arg == "--materials" && hasValue) {
-      only = bench::splitNames(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: slab_calibration [--grid N] [--spp N] [--ior jensen|1] [--materials a,b]\n");
-      return 2;
-    }
-  }
+  const bench::Flags flags(argc, argv, {"grid", "spp", "ior", "materials"},
+                           "slab_calibration [--grid N] [--spp N] [--ior jensen|1] [--materials a,b]");
+  if (!flags.ok()) return 2;
+  const int grid = flags.integer("grid", 64), spp = flags.integer("spp", 256);
+  const bool jensenIor = flags.text("ior", "jensen") != "1";
+  const std::vector<std::string> only = flags.names("materials", {});
   std::printf("# thick slab, normal directional light, view 10 deg off normal; pi L / E per channel\n");
   std::printf("# grid %d, steps auto, path tracer %d spp x 16 pixels\n", grid, spp);
   std::printf("%-9s %2s %5s %16s %7s %7s %8s %7s %8s\n", "material", "ch", "ior", "path tracer", "dipole",

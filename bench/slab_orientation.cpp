@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -55,22 +54,11 @@ Scene slabScene(const MeasuredMaterial& material, const Orientation& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int grid = 64, spp = 256;
-  std::vector<std::string> only = {"ketchup", "skin1", "marble"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const bool hasValue = i + 1 < argc;
-    if (arg == "--grid" && hasValue) {
-      grid = std::atoi(argv[++i]);
-    } else if (arg == "--spp" && hasValue) {
-      spp = std::atoi(argv[++i]);
-    } else if (arg == "--materials" && hasValue) {
-      only = bench::splitNames(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: slab_orientation [--grid N] [--spp N] [--materials a,b]\n");
-      return 2;
-    }
-  }
+  const bench::Flags flags(argc, argv, {"grid", "spp", "materials"},
+                           "slab_orientation [--grid N] [--spp N] [--materials a,b]");
+  if (!flags.ok()) return 2;
+  const int grid = flags.integer("grid", 64), spp = flags.integer("spp", 256);
+  const std::vector<std::string> only = flags.names("materials", {"ketchup", "skin1", "marble"});
   const Orientation orientations[] = {
       {"normal", 0.0, glm::dvec3(0.0)},
       {"incidence 45", 45.0, glm::dvec3(0.0)},

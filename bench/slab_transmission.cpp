@@ -11,7 +11,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -61,33 +60,16 @@ double exactNormalTransmission(double albedo, double opticalThickness, double et
   return slab.transmittedFlux[i] / (2.0 * slab.weight[i] * slab.mu[i] * eta * eta);
 }
 
-std::vector<double> parseList(const char* text) {
-  std::vector<double> values;
-  std::stringstream list(text);
-  for (std::string item; std::getline(list, item, ',');) values.push_back(std::atof(item.c_str()));
-  return values;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  int grid = 100;
-  std::vector<double> thicknesses = {4.0, 10.0, 20.0};
-  std::vector<std::string> only = {"jade", "ketchup", "skin1", "marble"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const bool hasValue = i + 1 < argc;
-    if (arg == "--grid" && hasValue) {
-      grid = std::atoi(argv[++i]);
-    } else if (arg == "--thickness" && hasValue) {
-      thicknesses = parseList(argv[++i]);
-    } else if (arg == "--materials" && hasValue) {
-      only = bench::splitNames(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: slab_transmission [--grid N] [--thickness a,b] [--materials a,b]\n");
-      return 2;
-    }
-  }
+  const bench::Flags flags(argc, argv, {"grid", "thickness", "materials"},
+                           "slab_transmission [--grid N] [--thickness a,b] [--materials a,b]");
+  if (!flags.ok()) return 2;
+  const int grid = flags.integer("grid", 100);
+  std::vector<double> thicknesses;
+  for (const std::string& t : flags.names("thickness", {"4", "10", "20"})) thicknesses.push_back(std::atof(t.c_str()));
+  const std::vector<std::string> only = flags.names("materials", {"jade", "ketchup", "skin1", "marble"});
   if (grid < 8 || thicknesses.empty() ||
       std::any_of(thicknesses.begin(), thicknesses.end(), [](double t) { return !(t > 0.0 && t < 100.0); })) {
     std::fprintf(stderr, "slab_transmission: need --grid >= 8 and thicknesses in (0, 100) mm\n");
