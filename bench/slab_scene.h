@@ -1,6 +1,7 @@
 #pragma once
 // Shared by the slab benchmarks: a box of one measured material with nothing else in the
 // scene yet, the calibrated settings they render with, and their command-line flags.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "volume/adding_doubling.h"
 #include "volume/material.h"
 #include "volume/scene.h"
 
@@ -44,6 +46,37 @@ inline std::vector<std::string> splitNames(const char* list) {
   std::stringstream in(list);
   for (std::string name; std::getline(in, name, ',');) names.push_back(name);
   return names;
+}
+
+/// Half the width of backlitSlab's slab, mm.
+inline constexpr double kBacklitHalfWidth = 30.0;
+
+/// A slab 60 x 60 mm wide and `thickness` mm thick, lit from above by a directional light
+/// of unit irradiance along its normal and seen from below: a 3-degree, 32 x 32 view of
+/// its unlit face's middle along the normal (bench/slab_transmission).
+inline Scene backlitSlab(const MeasuredMaterial& material, double thickness) {
+  Scene scene = materialBox(material, material.eta, glm::dvec3(-kBacklitHalfWidth, -thickness, -kBacklitHalfWidth),
+                            glm::dvec3(kBacklitHalfWidth, 0.0, kBacklitHalfWidth));
+  Light light;
+  light.type = Light::Type::Directional;
+  light.direction = glm::dvec3(0.0, -1.0, 0.0);
+  light.irradiance = glm::vec3(1.0f);
+  scene.lights = {light};
+  scene.camera.position = glm::dvec3(0.0, -thickness - 200.0, 0.0);
+  scene.camera.target = glm::dvec3(0.0, -thickness, 0.0);
+  scene.camera.up = glm::dvec3(0.0, 0.0, 1.0);
+  scene.camera.fovYDeg = 3.0;
+  scene.camera.width = scene.camera.height = 32;
+  return scene;
+}
+
+/// π L / E of the light a laterally infinite slab transmits, outside, along the normal,
+/// exactly (adding-doubling): the solution's node nearest the normal (its cosine is above
+/// 0.99 with 16 nodes; the exit shape is flat there).
+inline double exactNormalTransmission(double albedo, double opticalThickness, double eta) {
+  const SlabTransport slab = addingDoublingSlab(albedo, eta, opticalThickness);
+  const std::size_t i = std::size_t(std::max_element(slab.mu.begin(), slab.mu.end()) - slab.mu.begin());
+  return slab.transmittedFlux[i] / (2.0 * slab.weight[i] * slab.mu[i] * eta * eta);
 }
 
 /// "--name value" pairs, each flag taking one value; anything else, or a flag the program

@@ -25,39 +25,10 @@ namespace {
 
 using namespace sslpv;
 
-constexpr double kHalfWidth = 30.0;  // mm
-constexpr double kCameraDistance = 200.0;
-
 /// The shipped jade_slab_backlit medium beside Jensen's measured ones (g = 0 there, so
 /// σs' = σs).
 MeasuredMaterial jade() {
   return MeasuredMaterial{"jade", glm::vec3(0.8f, 1.0f, 0.7f), glm::vec3(0.2f, 0.025f, 0.15f), 1.5f};
-}
-
-Scene slabScene(const MeasuredMaterial& material, double thickness) {
-  Scene scene = bench::materialBox(material, material.eta, glm::dvec3(-kHalfWidth, -thickness, -kHalfWidth),
-                                   glm::dvec3(kHalfWidth, 0.0, kHalfWidth));
-  Light light;
-  light.type = Light::Type::Directional;
-  light.direction = glm::dvec3(0.0, -1.0, 0.0);
-  light.irradiance = glm::vec3(1.0f);
-  scene.lights = {light};
-  // From below, a 3-degree view of the unlit face's middle along its normal.
-  scene.camera.position = glm::dvec3(0.0, -thickness - kCameraDistance, 0.0);
-  scene.camera.target = glm::dvec3(0.0, -thickness, 0.0);
-  scene.camera.up = glm::dvec3(0.0, 0.0, 1.0);
-  scene.camera.fovYDeg = 3.0;
-  scene.camera.width = scene.camera.height = 32;
-  return scene;
-}
-
-/// π L / E of the light the slab transmits, outside, along the normal: the exact solution's
-/// node nearest the normal (its cosine is above 0.99 with 16 nodes; the exit shape is flat
-/// there).
-double exactNormalTransmission(double albedo, double opticalThickness, double eta) {
-  const SlabTransport slab = addingDoublingSlab(albedo, eta, opticalThickness);
-  const std::size_t i = std::size_t(std::max_element(slab.mu.begin(), slab.mu.end()) - slab.mu.begin());
-  return slab.transmittedFlux[i] / (2.0 * slab.weight[i] * slab.mu[i] * eta * eta);
 }
 
 }  // namespace
@@ -79,18 +50,18 @@ int main(int argc, char** argv) {
   materials.insert(materials.end(), measuredMaterials().begin(), measuredMaterials().end());
   std::printf("# slab 60x60 mm, L thick, lit from above along its normal, seen from below; SSLPV calibrated,\n");
   std::printf("# grid %d (cell %.2f mm), steps auto, against adding-doubling (exact). SSLPV / exact of the\n", grid,
-              2.0 * kHalfWidth / grid);
+              2.0 * bench::kBacklitHalfWidth / grid);
   std::printf("# transmitted radiance along the normal; 'exact' is its pi L / E, red.\n");
   std::printf("%-9s %6s %7s %7s %7s %10s\n", "material", "L mm", "R", "G", "B", "exact R");
   for (const MeasuredMaterial& material : materials) {
     if (std::find(only.begin(), only.end(), std::string(material.name)) == only.end()) continue;
     for (double thickness : thicknesses) {
-      const Scene scene = slabScene(material, thickness);
+      const Scene scene = bench::backlitSlab(material, thickness);
       const glm::dvec3 lpv = bench::meanRadiance(CpuRenderer(scene).render(bench::calibratedAuto(grid))) * M_PI;
       glm::dvec3 exact(0.0);
       for (int ch = 0; ch < 3; ++ch) {
         const double reducedT = material.sigmaSPrime[ch] + material.sigmaA[ch];
-        exact[ch] = exactNormalTransmission(material.sigmaSPrime[ch] / reducedT, reducedT * thickness, material.eta);
+        exact[ch] = bench::exactNormalTransmission(material.sigmaSPrime[ch] / reducedT, reducedT * thickness, material.eta);
       }
       const glm::dvec3 ratio = lpv / exact;
       std::printf("%-9s %6.1f %7.3f %7.3f %7.3f %10.3e\n", std::string(material.name).c_str(), thickness, ratio.x,
