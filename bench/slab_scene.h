@@ -70,11 +70,14 @@ inline Scene backlitSlab(const MeasuredMaterial& material, double thickness) {
   return scene;
 }
 
-/// π L / E of the light a laterally infinite slab transmits, outside, along the normal,
-/// exactly (adding-doubling): the solution's node nearest the normal (its cosine is above
-/// 0.99 with 16 nodes; the exit shape is flat there).
-inline double exactNormalTransmission(double albedo, double opticalThickness, double eta) {
-  const SlabTransport slab = addingDoublingSlab(albedo, eta, opticalThickness);
+/// π L / E of the light a laterally infinite slab of `material`, `thickness` mm thick,
+/// transmits in one channel, outside, along the normal, exactly (adding-doubling on the
+/// similarity relation's medium, as materialBox): the solution's node nearest the normal
+/// (its cosine is above 0.99 with 16 nodes; the exit shape is flat there).
+inline double exactNormalTransmission(const MeasuredMaterial& material, int channel, double thickness) {
+  const double reducedT = material.sigmaSPrime[channel] + material.sigmaA[channel];
+  const double eta = material.eta;
+  const SlabTransport slab = addingDoublingSlab(material.sigmaSPrime[channel] / reducedT, eta, reducedT * thickness);
   const std::size_t i = std::size_t(std::max_element(slab.mu.begin(), slab.mu.end()) - slab.mu.begin());
   return slab.transmittedFlux[i] / (2.0 * slab.weight[i] * slab.mu[i] * eta * eta);
 }

@@ -59,10 +59,7 @@ int main(int argc, char** argv) {
       const Scene scene = bench::backlitSlab(material, thickness);
       const glm::dvec3 lpv = bench::meanRadiance(CpuRenderer(scene).render(bench::calibratedAuto(grid))) * M_PI;
       glm::dvec3 exact(0.0);
-      for (int ch = 0; ch < 3; ++ch) {
-        const double reducedT = material.sigmaSPrime[ch] + material.sigmaA[ch];
-        exact[ch] = bench::exactNormalTransmission(material.sigmaSPrime[ch] / reducedT, reducedT * thickness, material.eta);
-      }
+      for (int ch = 0; ch < 3; ++ch) exact[ch] = bench::exactNormalTransmission(material, ch, thickness);
       const glm::dvec3 ratio = lpv / exact;
       std::printf("%-9s %6.1f %7.3f %7.3f %7.3f %10.3e\n", std::string(material.name).c_str(), thickness, ratio.x,
                   ratio.y, ratio.z, exact.x);

@@ -249,19 +249,26 @@ void doubleLayer(Matrix& r, Matrix& t, std::vector<double>& r0, std::vector<doub
   std::swap(t.a, next.a);
 }
 
+/// The arguments both solvers share: albedo in [0, 1], a positive finite eta, at least 2
+/// nodes, and a beam cosine that some beam from outside refracts to.
+void checkArguments(const char* caller, double albedo, double eta, const AddingDoublingOptions& options) {
+  const std::string name(caller);
+  if (!(albedo >= 0.0 && albedo <= 1.0)) throw std::invalid_argument(name + ": albedo must be in [0, 1]");
+  if (!(eta > 0.0) || !std::isfinite(eta)) throw std::invalid_argument(name + ": eta must be positive");
+  if (options.nodes < 2) throw std::invalid_argument(name + ": need at least 2 nodes");
+  const double mu0 = options.beamCosine;
+  if (!(mu0 > 0.0 && mu0 <= 1.0) || !(eta * eta * (1.0 - mu0 * mu0) < 1.0))
+    throw std::invalid_argument(name + ": no beam from outside refracts to that beam cosine");
+}
+
 }  // namespace
 
 HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const AddingDoublingOptions& options) {
-  if (!(albedo >= 0.0 && albedo <= 1.0))
-    throw std::invalid_argument("addingDoublingHalfSpace: albedo must be in [0, 1]");
-  if (!(eta > 0.0) || !std::isfinite(eta)) throw std::invalid_argument("addingDoublingHalfSpace: eta must be positive");
-  if (options.nodes < 2) throw std::invalid_argument("addingDoublingHalfSpace: need at least 2 nodes");
+  checkArguments("addingDoublingHalfSpace", albedo, eta, options);
   if (!(options.transmittanceTolerance > 0.0) || !(options.maxThickness > 0.0))
     throw std::invalid_argument("addingDoublingHalfSpace: tolerance and thickness must be positive");
   const double mu0 = options.beamCosine;
   const double sin2Outside = eta * eta * (1.0 - mu0 * mu0);
-  if (!(mu0 > 0.0 && mu0 <= 1.0) || !(sin2Outside < 1.0))
-    throw std::invalid_argument("addingDoublingHalfSpace: no beam from outside refracts to that beam cosine");
 
   HalfSpaceReflectance result;
   boundaryQuadrature(options.nodes, eta, result.mu, result.weight);
@@ -320,15 +327,11 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
 }
 
 SlabTransport addingDoublingSlab(double albedo, double eta, double thickness, const AddingDoublingOptions& options) {
-  if (!(albedo >= 0.0 && albedo <= 1.0)) throw std::invalid_argument("addingDoublingSlab: albedo must be in [0, 1]");
-  if (!(eta > 0.0) || !std::isfinite(eta)) throw std::invalid_argument("addingDoublingSlab: eta must be positive");
+  checkArguments("addingDoublingSlab", albedo, eta, options);
   if (!(thickness > 0.0) || !std::isfinite(thickness))
     throw std::invalid_argument("addingDoublingSlab: thickness must be positive");
-  if (options.nodes < 2) throw std::invalid_argument("addingDoublingSlab: need at least 2 nodes");
   const double mu0 = options.beamCosine;
   const double sin2Outside = eta * eta * (1.0 - mu0 * mu0);
-  if (!(mu0 > 0.0 && mu0 <= 1.0) || !(sin2Outside < 1.0))
-    throw std::invalid_argument("addingDoublingSlab: no beam from outside refracts to that beam cosine");
   std::vector<double> mu, w;
   boundaryQuadrature(options.nodes, eta, mu, w);
   const int n = int(mu.size());
