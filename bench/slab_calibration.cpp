@@ -60,13 +60,16 @@ int main(int argc, char** argv) {
   const int grid = flags.integer("grid", 64), spp = flags.integer("spp", 256);
   const bool jensenIor = flags.text("ior", "jensen") != "1";
   const std::vector<std::string> only = flags.names("materials", {});
+  bool known = true;
+  const std::vector<MeasuredMaterial> picked =
+      only.empty() ? measuredMaterials() : bench::pickMaterials(measuredMaterials(), only, "slab_calibration", known);
+  if (!known) return 2;
   std::printf("# thick slab, normal directional light, view 10 deg off normal; pi L / E per channel\n");
   std::printf("# grid %d, steps auto, path tracer %d spp x 16 pixels\n", grid, spp);
   std::printf("%-9s %2s %5s %16s %7s %7s %8s %7s %8s\n", "material", "ch", "ior", "path tracer", "dipole",
               "calib", "err", "seed", "err");
   double worst = 0.0;
-  for (const MeasuredMaterial& material : measuredMaterials()) {
-    if (!only.empty() && std::find(only.begin(), only.end(), std::string(material.name)) == only.end()) continue;
+  for (const MeasuredMaterial& material : picked) {
     const double ior = jensenIor ? material.eta : 1.0;
     Scene scene = slabScene(material, ior);
     ReferenceOptions options;

@@ -57,8 +57,12 @@ int main(int argc, char** argv) {
   const bench::Flags flags(argc, argv, {"grid", "spp", "materials"},
                            "slab_orientation [--grid N] [--spp N] [--materials a,b]");
   if (!flags.ok()) return 2;
+  bool known = true;
+  const std::vector<std::string> names = flags.names("materials", {"ketchup", "skin1", "marble"});
+  const std::vector<MeasuredMaterial> picked =
+      bench::pickMaterials(measuredMaterials(), names, "slab_orientation", known);
+  if (!known) return 2;
   const int grid = flags.integer("grid", 64), spp = flags.integer("spp", 256);
-  const std::vector<std::string> only = flags.names("materials", {"ketchup", "skin1", "marble"});
   const Orientation orientations[] = {
       {"normal", 0.0, glm::dvec3(0.0)},
       {"incidence 45", 45.0, glm::dvec3(0.0)},
@@ -72,8 +76,7 @@ int main(int argc, char** argv) {
   std::printf("# thick slab 60x30x60 mm, Jensen's eta; SSLPV calibrated, grid %d, steps auto;\n", grid);
   std::printf("# path tracer %d spp x 1024 pixels; SSLPV / path tracer of the mean radiance\n", spp);
   std::printf("%-9s %-14s %7s %7s %7s %9s\n", "material", "case", "R", "G", "B", "ref SE");
-  for (const MeasuredMaterial& material : measuredMaterials()) {
-    if (std::find(only.begin(), only.end(), std::string(material.name)) == only.end()) continue;
+  for (const MeasuredMaterial& material : picked) {
     for (const Orientation& o : orientations) {
       const Scene scene = slabScene(material, o);
       ReferenceOptions options;

@@ -82,6 +82,26 @@ inline double exactNormalTransmission(const MeasuredMaterial& material, int chan
   return slab.transmittedFlux[i] / (2.0 * slab.weight[i] * slab.mu[i] * eta * eta);
 }
 
+/// The materials of `available` that `names` asks for, in `available`'s order. A name
+/// none of them has prints a one-line reason naming it and makes `ok` false.
+inline std::vector<MeasuredMaterial> pickMaterials(const std::vector<MeasuredMaterial>& available,
+                                                   const std::vector<std::string>& names, const char* program,
+                                                   bool& ok) {
+  ok = true;
+  for (const std::string& name : names)
+    if (std::none_of(available.begin(), available.end(),
+                     [&](const MeasuredMaterial& m) { return name == std::string(m.name); })) {
+      std::string known;
+      for (const MeasuredMaterial& m : available) known += (known.empty() ? "" : ",") + std::string(m.name);
+      std::fprintf(stderr, "%s: unknown material '%s' (known: %s)\n", program, name.c_str(), known.c_str());
+      ok = false;
+    }
+  std::vector<MeasuredMaterial> picked;
+  for (const MeasuredMaterial& m : available)
+    if (std::find(names.begin(), names.end(), std::string(m.name)) != names.end()) picked.push_back(m);
+  return picked;
+}
+
 /// "--name value" pairs, each flag taking one value; anything else, or a flag the program
 /// does not know, prints `usage` and makes ok() false.
 class Flags {

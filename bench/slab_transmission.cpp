@@ -40,7 +40,6 @@ int main(int argc, char** argv) {
   const int grid = flags.integer("grid", 100);
   std::vector<double> thicknesses;
   for (const std::string& t : flags.names("thickness", {"4", "10", "20"})) thicknesses.push_back(std::atof(t.c_str()));
-  const std::vector<std::string> only = flags.names("materials", {"jade", "ketchup", "skin1", "marble"});
   if (grid < 8 || thicknesses.empty() ||
       std::any_of(thicknesses.begin(), thicknesses.end(), [](double t) { return !(t > 0.0 && t < 100.0); })) {
     std::fprintf(stderr, "slab_transmission: need --grid >= 8 and thicknesses in (0, 100) mm\n");
@@ -48,13 +47,16 @@ int main(int argc, char** argv) {
   }
   std::vector<MeasuredMaterial> materials = {jade()};
   materials.insert(materials.end(), measuredMaterials().begin(), measuredMaterials().end());
+  bool known = true;
+  const std::vector<MeasuredMaterial> picked = bench::pickMaterials(
+      materials, flags.names("materials", {"jade", "ketchup", "skin1", "marble"}), "slab_transmission", known);
+  if (!known) return 2;
   std::printf("# slab 60x60 mm, L thick, lit from above along its normal, seen from below; SSLPV calibrated,\n");
   std::printf("# grid %d (cell %.2f mm), steps auto, against adding-doubling (exact). SSLPV / exact of the\n", grid,
               2.0 * bench::kBacklitHalfWidth / grid);
   std::printf("# transmitted radiance along the normal; 'exact' is its pi L / E, red.\n");
   std::printf("%-9s %6s %7s %7s %7s %10s\n", "material", "L mm", "R", "G", "B", "exact R");
-  for (const MeasuredMaterial& material : materials) {
-    if (std::find(only.begin(), only.end(), std::string(material.name)) == only.end()) continue;
+  for (const MeasuredMaterial& material : picked) {
     for (double thickness : thicknesses) {
       const Scene scene = bench::backlitSlab(material, thickness);
       const glm::dvec3 lpv = bench::meanRadiance(CpuRenderer(scene).render(bench::calibratedAuto(grid))) * M_PI;
