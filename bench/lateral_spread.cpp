@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/band_profile.h"
 #include "bench/slab_scene.h"
 #include "volume/cpu_renderer.h"
 #include "volume/material.h"
@@ -29,9 +30,10 @@ constexpr double kLightHeight = 85.0;
 constexpr double kCameraHeight = 200.0;
 
 /// Ring edges in mm from the disk's centre: two inside it, the rim, then the far field.
-const double kRings[] = {0.0, 3.0, 6.0, 10.0, 14.0, 18.0, 22.0, 26.0};
-constexpr int kRingCount = int(sizeof(kRings) / sizeof(kRings[0])) - 1;
-/// A ring whose light is below this share of the centre ring's (per channel) is not compared.
+const std::vector<double> kRings = {0.0, 3.0, 6.0, 10.0, 14.0, 18.0, 22.0, 26.0};
+/// A ring whose light is below this share of the centre ring's (per channel) is not
+/// compared: almost single scattering, ketchup's green and blue beyond the rim say nothing
+/// about diffusion.
 constexpr double kNegligible = 1e-3;
 
 Scene diskScene(const MeasuredMaterial& material, int size) {
@@ -54,30 +56,11 @@ Scene diskScene(const MeasuredMaterial& material, int size) {
   return scene;
 }
 
-struct RingSums {
-  glm::dvec3 lpv{0.0}, reference{0.0}, variance{0.0};
-  int pixels = 0;
-};
-
-/// Sums each image over the rings; pixel (x, y) sees the face point under its centre.
-std::vector<RingSums> ringSums(const Image& lpv, const ReferenceResult& truth) {
-  std::vector<RingSums> rings(kRingCount);
-  const int size = lpv.width;
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      const double u = (2.0 * (x + 0.5) / size - 1.0) * kHalfWidth;
-      const double v = (2.0 * (y + 0.5) / size - 1.0) * kHalfWidth;
-      const double r = std::sqrt(u * u + v * v);
-      const int ring = int(std::upper_bound(std::begin(kRings), std::end(kRings), r) - std::begin(kRings)) - 1;
-      if (ring < 0 || ring >= kRingCount) continue;
-      RingSums& s = rings[std::size_t(ring)];
-      const glm::dvec3 se(truth.standardError.at(x, y));
-      s.lpv += glm::dvec3(lpv.at(x, y));
-      s.reference += glm::dvec3(truth.radiance.at(x, y));
-      s.variance += se * se;
-      ++s.pixels;
-    }
-  return rings;
+/// Pixel (x, y) sees the face point under its centre; its ring, -1 beyond the last.
+int ringAt(int x, int y, int size) {
+  const double u = (2.0 * (x + 0.5) / size - 1.0) * kHalfWidth;
+  const double v = (2.0 * (y + 0.5) / size - 1.0) * kHalfWidth;
+  return bench::bandOf(kRings, std::sqrt(u * u + v * v));
 }
 
 }  // namespace
@@ -86,8 +69,11 @@ int main(int argc, char** argv) {
   const bench::Flags flags(argc, argv, {"grid", "spp", "size", "materials"},
                            "lateral_spread [--grid N] [--spp N] [--size N] [--materials a,b]");
   if (!flags.ok()) return 2;
+  bool known = true;
+  const std::vector<std::string> names = flags.names("materials", {"ketchup", "skin1", "marble"});
+  const std::vector<MeasuredMaterial> picked = bench::pickMaterials(measuredMaterials(), names, "lateral_spread", known);
+  if (!known) return 2;
   const int grid = flags.integer("grid", 100), spp = flags.integer("spp", 64), size = flags.integer("size", 128);
-  const std::vector<std::string> only = flags.names("materials", {"ketchup", "skin1", "marble"});
   if (grid < 8 || spp < 1 || size < 16) {
     std::fprintf(stderr, "lateral_spread: need --grid >= 8, --spp >= 1, --size >= 16\n");
     return 2;
@@ -98,41 +84,15 @@ int main(int argc, char** argv) {
   std::printf("# Per ring: SSLPV / path tracer of the ring's mean radiance (R G B), the path tracer's\n");
   std::printf("# ring mean relative to the disk's centre ring (R), and its largest relative standard error.\n");
   std::printf("%-9s %-9s %7s %7s %7s %10s %8s\n", "material", "ring mm", "R", "G", "B", "ref R/ctr", "ref SE");
-  for (const MeasuredMaterial& material : measuredMaterials()) {
-    if (std::find(only.begin(), only.end(), std::string(material.name)) == only.end()) continue;
+  for (const MeasuredMaterial& material : picked) {
     const Scene scene = diskScene(material, size);
     ReferenceOptions options;
     options.spp = spp;
     const ReferenceResult truth = ReferenceTracer(scene).render(options);
     const Image lpv = CpuRenderer(scene).render(bench::calibratedAuto(grid));
-    const std::vector<RingSums> rings = ringSums(lpv, truth);
-    const glm::dvec3 centre = rings[0].reference / double(std::max(1, rings[0].pixels));
-    for (int k = 0; k < kRingCount; ++k) {
-      const RingSums& s = rings[std::size_t(k)];
-      if (s.pixels == 0) continue;
-      const glm::dvec3 mean = s.reference / double(s.pixels);
-      char ring[32], cells[3][16];
-      std::snprintf(ring, sizeof ring, "%g-%g", kRings[k], kRings[k + 1]);
-      double worstSe = 0.0;
-      for (int ch = 0; ch < 3; ++ch) {
-        // A channel that has died out in this ring (almost single scattering: ketchup's
-        // green and blue beyond the rim) says nothing about diffusion; leave it out.
-        if (!(mean[ch] > kNegligible * centre[ch])) {
-          std::snprintf(cells[ch], sizeof cells[ch], "%7s", "-");
-          continue;
-        }
-        std::snprintf(cells[ch], sizeof cells[ch], "%7.3f", s.lpv[ch] / s.reference[ch]);
-        worstSe = std::max(worstSe, std::sqrt(s.variance[ch]) / s.reference[ch]);
-      }
-      char se[16];
-      if (worstSe > 0.0)
-        std::snprintf(se, sizeof se, "%7.1f%%", 100.0 * worstSe);
-      else
-        std::snprintf(se, sizeof se, "%8s", "-");
-      std::printf("%-9s %-9s %s %s %s %10.2e %s\n", std::string(material.name).c_str(), ring, cells[0], cells[1],
-                  cells[2], mean.x / centre.x, se);
-    }
-    std::fflush(stdout);
+    const std::vector<bench::BandSums> rings = bench::bandSums(
+        lpv, truth, int(kRings.size()) - 1, [size](int x, int y) { return ringAt(x, y, size); });
+    bench::printBands(material.name, kRings, rings, kNegligible);
   }
   return 0;
 }
