@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "bench/slab_scene.h"
+#include "volume/cpu_renderer.h"
 #include "volume/image_io.h"
 #include "volume/reference_tracer.h"
 
@@ -74,6 +76,43 @@ inline void printBands(std::string_view material, const std::vector<double>& edg
                 cells[2], mean.x / first.x, se);
   }
   std::fflush(stdout);
+}
+
+/// The flags both band benchmarks take: --grid (SSLPV's), --spp and --size (the path
+/// tracer's samples and image size), --materials (default ketchup, skin1, marble).
+struct BandRun {
+  int grid = 100, spp = 64, size = 128;
+  std::vector<MeasuredMaterial> materials;
+};
+
+/// Parses the flags; false (after printing why) on anything it cannot use.
+inline bool parseBandRun(int argc, char** argv, const char* program, BandRun& run) {
+  const std::string usage = std::string(program) + " [--grid N] [--spp N] [--size N] [--materials a,b]";
+  const Flags flags(argc, argv, {"grid", "spp", "size", "materials"}, usage.c_str());
+  if (!flags.ok()) return false;
+  bool known = true;
+  run.materials =
+      pickMaterials(measuredMaterials(), flags.names("materials", {"ketchup", "skin1", "marble"}), program, known);
+  if (!known) return false;
+  run.grid = flags.integer("grid", run.grid);
+  run.spp = flags.integer("spp", run.spp);
+  run.size = flags.integer("size", run.size);
+  if (run.grid < 8 || run.spp < 1 || run.size < 16) {
+    std::fprintf(stderr, "%s: need --grid >= 8, --spp >= 1, --size >= 16\n", program);
+    return false;
+  }
+  return true;
+}
+
+/// Renders `scene` with the path tracer and calibrated SSLPV and prints their bands.
+template <class BandAt>
+void compareBands(const Scene& scene, std::string_view material, const BandRun& run,
+                  const std::vector<double>& edges, double negligible, BandAt&& bandAt) {
+  ReferenceOptions options;
+  options.spp = run.spp;
+  const ReferenceResult truth = ReferenceTracer(scene).render(options);
+  const Image lpv = CpuRenderer(scene).render(calibratedAuto(run.grid));
+  printBands(material, edges, bandSums(lpv, truth, int(edges.size()) - 1, bandAt), negligible);
 }
 
 }  // namespace sslpv::bench

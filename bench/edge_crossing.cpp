@@ -6,17 +6,12 @@
 // without the box's rotation, so the grid's staircase is not in it.
 //
 //   edge_crossing [--grid 100] [--spp 64] [--size 128] [--materials ketchup,skin1,marble]
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
 #include <vector>
 
 #include "bench/band_profile.h"
-#include "bench/slab_scene.h"
-#include "volume/cpu_renderer.h"
 #include "volume/material.h"
-#include "volume/reference_tracer.h"
 #include "volume/scene.h"
 
 namespace {
@@ -54,35 +49,17 @@ Scene edgeScene(const MeasuredMaterial& material, int size) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bench::Flags flags(argc, argv, {"grid", "spp", "size", "materials"},
-                           "edge_crossing [--grid N] [--spp N] [--size N] [--materials a,b]");
-  if (!flags.ok()) return 2;
-  bool known = true;
-  const std::vector<std::string> names = flags.names("materials", {"ketchup", "skin1", "marble"});
-  const std::vector<MeasuredMaterial> picked = bench::pickMaterials(measuredMaterials(), names, "edge_crossing", known);
-  if (!known) return 2;
-  const int grid = flags.integer("grid", 100), spp = flags.integer("spp", 64), size = flags.integer("size", 128);
-  if (grid < 8 || spp < 1 || size < 16) {
-    std::fprintf(stderr, "edge_crossing: need --grid >= 8, --spp >= 1, --size >= 16\n");
-    return 2;
-  }
+  bench::BandRun run;
+  if (!bench::parseBandRun(argc, argv, "edge_crossing", run)) return 2;
   std::printf("# box 60x30x30 mm lit from straight above only, Jensen's eta; a side face seen square-on.\n");
-  std::printf("# SSLPV calibrated, grid %d (cell %.2f mm), steps auto; path tracer %d spp, %dx%d pixels.\n", grid,
-              2.0 * kHalfWidth / grid, spp, size, size);
+  std::printf("# SSLPV calibrated, grid %d (cell %.2f mm), steps auto; path tracer %d spp, %dx%d pixels.\n", run.grid,
+              2.0 * kHalfWidth / run.grid, run.spp, run.size, run.size);
   std::printf("# Per band below the lit edge: SSLPV / path tracer of the band's mean radiance (R G B),\n");
   std::printf("# the path tracer's band mean relative to the first band's (R), its largest relative SE.\n");
   std::printf("%-9s %-9s %7s %7s %7s %10s %8s\n", "material", "depth mm", "R", "G", "B", "ref R/1st", "ref SE");
-  for (const MeasuredMaterial& material : picked) {
-    const Scene scene = edgeScene(material, size);
-    ReferenceOptions options;
-    options.spp = spp;
-    const ReferenceResult truth = ReferenceTracer(scene).render(options);
-    const Image lpv = CpuRenderer(scene).render(bench::calibratedAuto(grid));
-    // Pixel row y sees the face (y + 1/2) / size · 2 kView below the edge.
-    const std::vector<bench::BandSums> bands =
-        bench::bandSums(lpv, truth, int(kBands.size()) - 1,
-                        [size](int, int y) { return bench::bandOf(kBands, (y + 0.5) / size * 2.0 * kView); });
-    bench::printBands(material.name, kBands, bands, kNegligible);
-  }
+  // Pixel row y sees the face (y + 1/2) / size · 2 kView below the edge.
+  for (const MeasuredMaterial& material : run.materials)
+    bench::compareBands(edgeScene(material, run.size), material.name, run, kBands, kNegligible,
+                        [&run](int, int y) { return bench::bandOf(kBands, (y + 0.5) / run.size * 2.0 * kView); });
   return 0;
 }

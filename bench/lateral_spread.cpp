@@ -6,18 +6,12 @@
 // the rings outside measure the lattice's far field against transport's.
 //
 //   lateral_spread [--grid 100] [--spp 64] [--size 128] [--materials ketchup,skin1,marble]
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <string>
 #include <vector>
 
 #include "bench/band_profile.h"
-#include "bench/slab_scene.h"
-#include "volume/cpu_renderer.h"
 #include "volume/material.h"
-#include "volume/reference_tracer.h"
 #include "volume/scene.h"
 
 namespace {
@@ -66,33 +60,16 @@ int ringAt(int x, int y, int size) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bench::Flags flags(argc, argv, {"grid", "spp", "size", "materials"},
-                           "lateral_spread [--grid N] [--spp N] [--size N] [--materials a,b]");
-  if (!flags.ok()) return 2;
-  bool known = true;
-  const std::vector<std::string> names = flags.names("materials", {"ketchup", "skin1", "marble"});
-  const std::vector<MeasuredMaterial> picked = bench::pickMaterials(measuredMaterials(), names, "lateral_spread", known);
-  if (!known) return 2;
-  const int grid = flags.integer("grid", 100), spp = flags.integer("spp", 64), size = flags.integer("size", 128);
-  if (grid < 8 || spp < 1 || size < 16) {
-    std::fprintf(stderr, "lateral_spread: need --grid >= 8, --spp >= 1, --size >= 16\n");
-    return 2;
-  }
+  bench::BandRun run;
+  if (!bench::parseBandRun(argc, argv, "lateral_spread", run)) return 2;
   std::printf("# slab 60x60x30 mm lit on a disk of radius %.0f mm, Jensen's eta, seen from above;\n", kDiskRadius);
-  std::printf("# SSLPV calibrated, grid %d (cell %.2f mm), steps auto; path tracer %d spp, %dx%d pixels.\n", grid,
-              2.0 * kHalfWidth / grid, spp, size, size);
+  std::printf("# SSLPV calibrated, grid %d (cell %.2f mm), steps auto; path tracer %d spp, %dx%d pixels.\n", run.grid,
+              2.0 * kHalfWidth / run.grid, run.spp, run.size, run.size);
   std::printf("# Per ring: SSLPV / path tracer of the ring's mean radiance (R G B), the path tracer's\n");
   std::printf("# ring mean relative to the disk's centre ring (R), and its largest relative standard error.\n");
   std::printf("%-9s %-9s %7s %7s %7s %10s %8s\n", "material", "ring mm", "R", "G", "B", "ref R/ctr", "ref SE");
-  for (const MeasuredMaterial& material : picked) {
-    const Scene scene = diskScene(material, size);
-    ReferenceOptions options;
-    options.spp = spp;
-    const ReferenceResult truth = ReferenceTracer(scene).render(options);
-    const Image lpv = CpuRenderer(scene).render(bench::calibratedAuto(grid));
-    const std::vector<bench::BandSums> rings = bench::bandSums(
-        lpv, truth, int(kRings.size()) - 1, [size](int x, int y) { return ringAt(x, y, size); });
-    bench::printBands(material.name, kRings, rings, kNegligible);
-  }
+  for (const MeasuredMaterial& material : run.materials)
+    bench::compareBands(diskScene(material, run.size), material.name, run, kRings, kNegligible,
+                        [&run](int x, int y) { return ringAt(x, y, run.size); });
   return 0;
 }
