@@ -14,18 +14,15 @@
 #include "bench/image_mean.h"
 #include "bench/slab_scene.h"
 #include "volume/cpu_renderer.h"
+#include "volume/material.h"
 
 namespace sslpv::test {
 namespace {
 
-const MeasuredMaterial& marble() {
-  for (const MeasuredMaterial& m : measuredMaterials())
-    if (m.name == "marble") return m;
-  throw std::logic_error("no marble among the measured materials");
-}
-
 TEST(SlabTransmission, HighAlbedoSlabMatchesExactTransport) {
-  const MeasuredMaterial& material = marble();
+  const MeasuredMaterial* marble = findMeasuredMaterial("marble");
+  ASSERT_NE(marble, nullptr);
+  const MeasuredMaterial& material = *marble;
   for (double thickness : {4.0, 10.0}) {
     const Scene scene = bench::backlitSlab(material, thickness);
     const glm::dvec3 lpv = M_PI * bench::meanRadiance(CpuRenderer(scene).render(bench::calibratedAuto(100)));

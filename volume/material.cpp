@@ -25,24 +25,28 @@ const std::vector<MeasuredMaterial>& measuredMaterials() {
   return table;
 }
 
+const MeasuredMaterial* findMeasuredMaterial(std::string_view name) {
+  for (const MeasuredMaterial& m : measuredMaterials())
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
 std::optional<MaterialSample> presetMaterial(std::string_view name, float g,
                                              double sceneUnitInMm) {
-  for (const MeasuredMaterial& m : measuredMaterials()) {
-    if (m.name != name) continue;
-    // The measurement only fixes the reduced coefficient sigma_s' = sigma_s (1 - g): for a
-    // chosen g, the similarity relation gives the sigma_s with the same diffusion behaviour.
-    // Computed in double so that a g close to 1 does not lose the small sigma_a.
-    MaterialSample sample;
-    sample.g = g;
-    for (int c = 0; c < 3; ++c) {
-      double sigmaS = double(m.sigmaSPrime[c]) / (1.0 - double(g)) * sceneUnitInMm;
-      double sigmaA = double(m.sigmaA[c]) * sceneUnitInMm;
-      sample.sigmaS[c] = float(sigmaS);
-      sample.sigmaT[c] = float(sigmaS + sigmaA);
-    }
-    return sample;
+  const MeasuredMaterial* m = findMeasuredMaterial(name);
+  if (m == nullptr) return std::nullopt;
+  // The measurement only fixes the reduced coefficient sigma_s' = sigma_s (1 - g): for a
+  // chosen g, the similarity relation gives the sigma_s with the same diffusion behaviour.
+  // Computed in double so that a g close to 1 does not lose the small sigma_a.
+  MaterialSample sample;
+  sample.g = g;
+  for (int c = 0; c < 3; ++c) {
+    double sigmaS = double(m->sigmaSPrime[c]) / (1.0 - double(g)) * sceneUnitInMm;
+    double sigmaA = double(m->sigmaA[c]) * sceneUnitInMm;
+    sample.sigmaS[c] = float(sigmaS);
+    sample.sigmaT[c] = float(sigmaS + sigmaA);
   }
-  return std::nullopt;
+  return sample;
 }
 
 std::string presetNames() {

@@ -27,6 +27,9 @@ struct MeasuredMaterial {
 /// Jensen 2001's eleven measured materials, in table order.
 const std::vector<MeasuredMaterial>& measuredMaterials();
 
+/// The measured material of that name, nullptr when there is none.
+const MeasuredMaterial* findMeasuredMaterial(std::string_view name);
+
 /// The preset's MaterialSample for asymmetry g (sigma_s = sigma_s' / (1 - g)), converted
 /// from mm^-1 to per scene unit (`sceneUnitInMm` millimetres per scene unit).
 /// std::nullopt when the name is unknown.
