@@ -16,7 +16,6 @@
 
 #include "bench/image_mean.h"
 #include "bench/slab_scene.h"
-#include "volume/adding_doubling.h"
 #include "volume/cpu_renderer.h"
 #include "volume/material.h"
 #include "volume/scene.h"

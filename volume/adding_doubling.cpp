@@ -249,6 +249,21 @@ void doubleLayer(Matrix& r, Matrix& t, std::vector<double>& r0, std::vector<doub
   std::swap(t.a, next.a);
 }
 
+/// The starting layer's thickness: `from` halved until δ/μ stays under 1/2 for every
+/// node and the beam, where its transfer matrix exp(δK) (see thinLayer) is well
+/// conditioned and its Taylor series converges in ~20 terms. `halvings` counts them, so
+/// that doubling the layer as often gives back `from` exactly.
+double startingThickness(double from, const std::vector<double>& mu, double mu0, int& halvings) {
+  const double muMin = std::min(mu0, *std::min_element(mu.begin(), mu.end()));
+  double delta = from;
+  halvings = 0;
+  while (delta > 0.5 * muMin) {
+    delta *= 0.5;
+    ++halvings;
+  }
+  return delta;
+}
+
 /// The arguments both solvers share: albedo in [0, 1], a positive finite eta, at least 2
 /// nodes, and a beam cosine that some beam from outside refracts to.
 void checkArguments(const char* caller, double albedo, double eta, const AddingDoublingOptions& options) {
@@ -276,11 +291,8 @@ HalfSpaceReflectance addingDoublingHalfSpace(double albedo, double eta, const Ad
   const std::vector<double>& mu = result.mu;
   const std::vector<double>& w = result.weight;
 
-  // The starting layer: its transfer matrix exp(δK) (see thinLayer) is well conditioned
-  // while δ/μ stays near 1 and its Taylor series then converges in ~20 terms.
-  const double muMin = std::min(mu0, *std::min_element(mu.begin(), mu.end()));
-  double delta = 1.0;
-  while (delta > 0.5 * muMin) delta *= 0.5;
+  int halvings = 0;
+  const double delta = startingThickness(1.0, mu, mu0, halvings);
   const std::size_t bins = mu.size();
   Matrix r(n), t(n);
   std::vector<double> r0(bins), t0(bins);
@@ -336,14 +348,8 @@ SlabTransport addingDoublingSlab(double albedo, double eta, double thickness, co
   boundaryQuadrature(options.nodes, eta, mu, w);
   const int n = int(mu.size());
   const std::size_t bins = mu.size();
-  // thickness / 2^k, small enough for the starting layer (as the half-space's), doubled k times.
-  const double muMin = std::min(mu0, *std::min_element(mu.begin(), mu.end()));
   int doublings = 0;
-  double delta = thickness;
-  while (delta > 0.5 * muMin) {
-    delta *= 0.5;
-    ++doublings;
-  }
+  const double delta = startingThickness(thickness, mu, mu0, doublings);
   Matrix r(n), t(n);
   std::vector<double> r0(bins), t0(bins);
   thinLayer(albedo, mu, w, mu0, delta, r, t, r0, t0);
