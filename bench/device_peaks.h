@@ -16,6 +16,8 @@ namespace sslpv::bench {
 
 inline constexpr double kFlopsPerCellStep = 3 * (169 + 7 + 24) + 3 * 24 + 42 + 12;
 inline constexpr double kBytesPerCellStep = 48 + 32 + 48 + 48;
+/// The calibrated scheme's isotropic steps (gpu_propagation_bench's header): same bytes.
+inline constexpr double kIsotropicFlopsPerCellStep = 3 * (4 + 24 + 2 + 13 + 4);
 
 inline double medianOf(std::vector<double> values) {
   if (values.empty()) return 0.0;

@@ -3,8 +3,8 @@
 // sphere or a thin spherical shell. Prints a table; a program, not a test (no asserts).
 //
 //   gpu_propagation_bench [--sizes 16,32,64,128] [--steps 4,8,16,32,auto]
-//                         [--shapes cube,sphere,shell] [--repeats 5] [--rows N] [--zchunk N]
-//                         [--no-cpu]
+//                         [--shapes cube,sphere,shell] [--schemes seed,calibrated]
+//                         [--repeats 5] [--rows N] [--zchunk N] [--no-cpu]
 //
 // Every time is the MEDIAN of --repeats runs after one warm-up run (shader JIT, caches).
 // GPU ms/step: propagation kernel + per-step reduction from GPU timestamps, divided by
@@ -25,7 +25,11 @@
 //   accumulate (2 adds x 12 floats, every other step)                           =  12
 //   total                                                                        726 flop
 // (the CPU's structure, normalize then evaluate the faces again per neighbour, needs
-// 1024). Bytes per active cell and step, compulsory memory traffic (halos assumed
+// 1024). The calibrated scheme keeps every cell isotropic, so its steps after the first
+// run as a stencil on c0 (the "isotropic" rows; "general" rows force the kernel above on
+// the same factors, for comparison): per channel, the cell's power and its lobe (4), the
+// 6 lobes added as vec4 (24), retention (2), step factors and power sums (13),
+// accumulate (4) = 141 flop on the same 176 B, so those rows are bandwidth-bound. Bytes per active cell and step, compulsory memory traffic (halos assumed
 // cached): source 48 + factors 32 + destination 48 + accumulated (48 read + 48 written
 // every other step) 48 = 176 B, so 4.1 flop/B. Attainable = min(peak FMA, 4.1 x
 // bandwidth); "roof %" is the kernel's achieved GFLOP/s over that.
@@ -122,6 +126,7 @@ struct BenchOptions {
   std::vector<int> sizes{16, 32, 64, 128};
   std::vector<int> steps{4, 8, 16, 32, 0};  // 0: auto
   std::vector<Shape> shapes{Shape::Cube, Shape::Sphere, Shape::Shell};
+  std::vector<LpvScheme> schemes{LpvScheme::Seed};
   int repeats = 5;
   bool cpu = true;
   gpu::GpuPropagatorOptions gpu;
@@ -171,6 +176,14 @@ BenchOptions parseOptions(int argc, char** argv) {
         else if (item == "sphere") options.shapes.push_back(Shape::Sphere);
         else if (item == "shell") options.shapes.push_back(Shape::Shell);
         else throw std::invalid_argument("unknown shape " + item + " for --shapes (cube, sphere, shell)");
+      }
+    } else if (flag == "--schemes") {
+      options.schemes.clear();
+      for (const std::string& item : splitList(value)) {
+        LpvScheme scheme{};
+        if (!parseLpvScheme(item, scheme))
+          throw std::invalid_argument("unknown scheme " + item + " for --schemes (seed, calibrated)");
+        options.schemes.push_back(scheme);
       }
     } else if (flag == "--repeats") {
       options.repeats = parseInt(flag, value);
@@ -240,7 +253,7 @@ int main(int argc, char** argv) {
   try {
     gpu::VulkanDevice device;
     PeakProbe probe(device);
-    const double intensity = kFlopsPerCellStep / kBytesPerCellStep;
+    const double intensity = kFlopsPerCellStep / kBytesPerCellStep;  // the general step's
     const Peaks start = probe.measure(bench.repeats);
     std::printf("device: %s; times are medians of %d runs after a warm-up\n", device.name().c_str(), bench.repeats);
     std::printf("peaks at the start: FMA %.1f GFLOP/s; vec4 triad %.2f GB/s (storage buffers), %.2f GB/s (texel reads)\n",
@@ -248,36 +261,48 @@ int main(int argc, char** argv) {
     std::printf("per active cell-step: %.0f flop, %.0f B (%.1f flop/B); roofline = min(FMA peak, %.1f x triad peak),\n"
                 "both peaks measured again just before each row (peak GF, GB/s columns)\n",
                 kFlopsPerCellStep, kBytesPerCellStep, intensity, intensity);
-    std::printf("%5s %6s %5s %8s %8s %5s | %8s %8s %8s %8s %7s %7s | %7s %6s %6s | %8s %8s %7s\n", "grid", "shape",
-                "steps", "active", "covered", "items", "gpu ms", "wall ms", "proc ms", "Mcell/s", "GFLOP/s", "GB/s",
+    std::printf("%5s %6s %14s %5s %8s %8s %5s | %8s %8s %8s %8s %7s %7s | %7s %6s %6s | %8s %8s %7s\n", "grid",
+                "shape", "scheme/step", "steps", "active", "covered", "items", "gpu ms", "wall ms", "proc ms", "Mcell/s", "GFLOP/s", "GB/s",
                 "peak GF", "GB/s", "roof%", "cpu ms", "Mcell/s", "cpu/gpu");
     for (int n : bench.sizes)
-      for (Shape shape : bench.shapes) {
-        const MaterialGrid material = makeMaterial(n, shape);
-        const StepFactors factors = computeStepFactors(material);
-        const ShGrid injected = litField(material, factors);
-        gpu::GpuPropagator propagator(device, material.frame, factors, bench.gpu);
-        const double active = double(propagator.activeCells());
-        for (int steps : bench.steps) {
-          PropagationOptions options;
-          options.steps = steps;
-          options.autoSteps = steps == 0;
-          const Peaks peaks = probe.measure(3);
-          const double roof = std::min(peaks.fmaGflops, intensity * peaks.bandwidth());
-          const GpuRun gpuRun = benchGpu(propagator, injected, options, bench.repeats);
-          const double cellRate = active / (gpuRun.kernelMs * 1e-3);  // active cells per second
-          const double gflops = cellRate * kFlopsPerCellStep * 1e-9;
-          const double cpuMs = bench.cpu ? benchCpu(material, factors, injected, options, bench.repeats) : 0.0;
-          const std::string stepsText = steps > 0 ? std::to_string(steps) : "a" + std::to_string(gpuRun.steps);
-          std::printf(
-              "%4d^3 %6s %5s %8.0f %8zu %5zu | %8.3f %8.3f %8.3f %8.1f %7.2f %7.2f | %7.1f %6.2f %6.1f | %8.3f %8.1f %7.2f\n",
-              n, shapeName(shape), stepsText.c_str(), active, propagator.coveredCells(), propagator.itemCount(),
-              gpuRun.kernelMs, gpuRun.wallMs, gpuRun.cpuMs, cellRate * 1e-6, gflops, cellRate * kBytesPerCellStep * 1e-9,
-              peaks.fmaGflops, peaks.bandwidth(), 100.0 * gflops / roof, cpuMs,
-              cpuMs > 0.0 ? active / (cpuMs * 1e3) : 0.0, cpuMs > 0.0 ? cpuMs / gpuRun.kernelMs : 0.0);
-          std::fflush(stdout);
+      for (Shape shape : bench.shapes)
+        for (LpvScheme scheme : bench.schemes) {
+          const MaterialGrid material = makeMaterial(n, shape);
+          const StepFactors factors = computeStepFactors(material, scheme, 1.4);
+          const ShGrid injected = litField(material, factors);
+          // The calibrated scheme's isotropic steps, and its factors through the general step.
+          const bool isotropicScheme = keepsCellsIsotropic(factors);
+          for (bool isotropic : isotropicScheme ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
+            gpu::GpuPropagatorOptions gpuOptions = bench.gpu;
+            gpuOptions.isotropicSteps = isotropic;
+            gpu::GpuPropagator propagator(device, material.frame, factors, gpuOptions);
+            const double active = double(propagator.activeCells());
+            const double flops = isotropic ? bench::kIsotropicFlopsPerCellStep : kFlopsPerCellStep;
+            const double cellIntensity = flops / kBytesPerCellStep;
+            const std::string variant = lpvSchemeName(scheme) + (isotropicScheme ? isotropic ? "/iso" : "/gen" : "");
+            for (int steps : bench.steps) {
+              PropagationOptions options;
+              options.steps = steps;
+              options.autoSteps = steps == 0;
+              options.isotropicFastPath = isotropic;
+              const Peaks peaks = probe.measure(3);
+              const double roof = std::min(peaks.fmaGflops, cellIntensity * peaks.bandwidth());
+              const GpuRun gpuRun = benchGpu(propagator, injected, options, bench.repeats);
+              const double cellRate = active / (gpuRun.kernelMs * 1e-3);  // active cells per second
+              const double gflops = cellRate * flops * 1e-9;
+              const double cpuMs = bench.cpu ? benchCpu(material, factors, injected, options, bench.repeats) : 0.0;
+              const std::string stepsText = steps > 0 ? std::to_string(steps) : "a" + std::to_string(gpuRun.steps);
+              std::printf(
+                  "%4d^3 %6s %14s %5s %8.0f %8zu %5zu | %8.3f %8.3f %8.3f %8.1f %7.2f %7.2f | %7.1f %6.2f %6.1f | %8.3f "
+                  "%8.1f %7.2f\n",
+                  n, shapeName(shape), variant.c_str(), stepsText.c_str(), active, propagator.coveredCells(),
+                  propagator.itemCount(), gpuRun.kernelMs, gpuRun.wallMs, gpuRun.cpuMs, cellRate * 1e-6, gflops,
+                  cellRate * kBytesPerCellStep * 1e-9, peaks.fmaGflops, peaks.bandwidth(), 100.0 * gflops / roof, cpuMs,
+                  cpuMs > 0.0 ? active / (cpuMs * 1e3) : 0.0, cpuMs > 0.0 ? cpuMs / gpuRun.kernelMs : 0.0);
+              std::fflush(stdout);
+            }
+          }
         }
-      }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gpu_propagation_bench: %s\n", e.what());
     return 1;

@@ -378,6 +378,12 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
     commands_.submitAndWait();
   }
   active_ = factors.active;
+  isotropicSteps_ = options_.isotropicSteps && keepsCellsIsotropic(factors);
+  if (isotropicSteps_ && isotropicPipelines_[0].pipeline() == VK_NULL_HANDLE)
+    for (std::uint32_t variant = 0; variant < 2; ++variant)
+      isotropicPipelines_[variant] = ComputePipeline(device_, spirv::lpv_propagate_comp(), setLayout_.get(),
+                                                     sizeof(LpvStepPush),
+                                                     {std::uint32_t(options_.tileRows), variant, 1u});
   freshGain_ = factors.freshGain;
   buildItems(factors);
 }
@@ -471,7 +477,10 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
     // starts the accumulated grid with both, then even steps add.
     if (mode == Mode::Host) push.accumulate = step % 2 == 1 ? 1 : 0;
     if (mode == Mode::Device) push.accumulate = step == 0 ? 2 : step % 2 == 0 ? 1 : 0;
-    propagatePipelines_[push.accumulate != 0].bind(cmd, sets_[step % 2], &push, sizeof(push));
+    // Step 0 reads the injected light, which may hold a linear band; after it, factors
+    // that keep cells isotropic have left none.
+    const ComputePipeline* pipelines = isotropicSteps_ && step > 0 ? isotropicPipelines_ : propagatePipelines_;
+    pipelines[push.accumulate != 0].bind(cmd, sets_[step % 2], &push, sizeof(push));
     if (groups > 0) vkCmdDispatch(cmd, groups, 1, 1);
     computeToComputeBarrier(cmd);
     if (timestamps) timestamps_.write(cmd, 1 + 2 * std::uint32_t(s));

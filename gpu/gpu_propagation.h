@@ -28,6 +28,9 @@ struct GpuPropagatorOptions {
   int stepsPerSubmission = 32;
   /// Go through staging buffers even where device memory is mappable (tests that path).
   bool forceStaging = false;
+  /// Run the steps after the first as a c0 stencil where the factors keep cells isotropic
+  /// (PropagationOptions::isotropicFastPath). Off only to measure the general kernel.
+  bool isotropicSteps = true;
 };
 
 /// GPU time of the last run() or runOnDevice(), from timestamps (0 where the queue has
@@ -144,6 +147,10 @@ class GpuPropagator {
   DescriptorPool pool_;
   VkDescriptorSet sets_[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};  ///< set k reads tiled_[k]
   ComputePipeline propagatePipelines_[2];   ///< without and with accumulation
+  /// The same for the steps after the first where the factors keep cells isotropic
+  /// (keepsCellsIsotropic), built on first need.
+  ComputePipeline isotropicPipelines_[2];
+  bool isotropicSteps_ = false;
   ComputePipeline finishPipelines_[2];      ///< into tiled_ / linear accumulated light
   ComputePipeline reducePipeline_, importPipeline_;
   Buffer linearSource_, linearAccumulated_;  ///< x-fastest, shared with injection and shading

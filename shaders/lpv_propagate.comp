@@ -35,6 +35,9 @@ layout(local_size_x = SSLPV_TILE_X) in;
 /// accumulated = source + result, the first step of a device-resident run, which needs
 /// no cleared buffer). 0: it does not.
 layout(constant_id = 1) const int ACCUMULATE = 0;
+/// 1: the source field has no linear band and the step factors keep it so (the calibrated
+/// scheme after its first step): emitIsotropicChannel instead of the clamped faces.
+layout(constant_id = 2) const int ISOTROPIC = 0;
 
 const int W = SSLPV_TILE_X;
 const int HALF = SSLPV_TILE_X / 2;
@@ -71,8 +74,12 @@ CellLobes emitCell(int x, int y, int z, float owned, inout StepSums sums) {
   const vec3 conductance = fetchConductance(x, y, z);
   CellLobes lobes;
   vec3 emitted = vec3(0.0), clampRemoved = vec3(0.0);
-  for (int ch = 0; ch < 3; ++ch)
-    lobes.ch[ch] = emitChannel(raw.c[ch], conductance[ch], emitted[ch], clampRemoved[ch]);
+  for (int ch = 0; ch < 3; ++ch) {
+    if (ISOTROPIC != 0)
+      lobes.ch[ch] = emitIsotropicChannel(raw.c[ch], conductance[ch], emitted[ch]);
+    else
+      lobes.ch[ch] = emitChannel(raw.c[ch], conductance[ch], emitted[ch], clampRemoved[ch]);
+  }
   sums.emitted += owned * emitted;
   sums.clampRemoved += owned * clampRemoved;
   sums.source += owned * vec3(raw.c[0].x, raw.c[1].x, raw.c[2].x);

@@ -1,7 +1,10 @@
 // Propagation: conservation, energy bookkeeping step by step, the clamp, and stability.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
+#include <string>
 
 #include "lpv_test_grids.h"
 #include "volume/adding_doubling.h"
@@ -301,6 +304,131 @@ TEST(Propagation, AutoStepsReachTheConvergedLightFarFromTheSource) {
   ASSERT_LT(convergedSteps, PropagationOptions{}.maxAutoSteps);
   EXPECT_LT(incrementOnly, 0.9 * converged) << "the case must be one the increment rule gets wrong";
   EXPECT_NEAR(autoRule, converged, 0.01 * converged);
+}
+
+/// A ball of medium on 1 mm cells with random coverage, light in every active cell and,
+/// with `lobes`, a few cells with a linear band. Heterogeneous (σt, albedo and g vary per
+/// cell, so the calibrated factors hold a conductance), or uniform and dense (a mean free
+/// path of 0.12 cells: z_b under half a cell, so boundary cells keep a negative share).
+struct Ball {
+  MaterialGrid material;
+  ShGrid injected;
+};
+Ball ballCase(int dims, bool heterogeneous, bool lobes, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  Ball b;
+  b.material = uniformMaterial(dims, glm::vec3(12.0f), glm::vec3(11.99f), 0.3f, 1.0);
+  MaterialGrid& m = b.material;
+  const float centre = 0.5f * float(dims), radius = 0.42f * float(dims);
+  for (int z = 0; z < dims; ++z)
+    for (int y = 0; y < dims; ++y)
+      for (int x = 0; x < dims; ++x) {
+        const std::size_t i = m.frame.index(x, y, z);
+        const float r = glm::length(glm::vec3(x, y, z) + 0.5f - centre);
+        m.coverage[i] = r < radius ? 0.3f + 0.7f * unit(rng) : 0.0f;
+        if (!heterogeneous) continue;
+        for (int ch = 0; ch < 3; ++ch) {
+          m.sigmaT[i][ch] = 0.5f + 8.0f * unit(rng);
+          m.sigmaS[i][ch] = (0.97f + 0.03f * unit(rng)) * m.sigmaT[i][ch];
+        }
+        m.g[i] = 0.5f * unit(rng);
+      }
+  b.injected.resize(m.frame);
+  for (int z = 0; z < dims; ++z)
+    for (int y = 0; y < dims; ++y)
+      for (int x = 0; x < dims; ++x) {
+        if (!isActiveCell(m, x, y, z)) continue;
+        for (int ch = 0; ch < 3; ++ch) b.injected.plane(ch, 0)[m.frame.index(x, y, z)] = unit(rng);
+        if (lobes && unit(rng) < 0.02f) putLobe(b.injected, x, y, z, glm::normalize(glm::vec3(1, -2, 0.5f)), 4.0f);
+      }
+  return b;
+}
+
+TEST(Propagation, CalibratedIsotropicStepsMatchTheGeneralStep) {
+  // The calibrated scheme's fast path (a c0 stencil) against the general SH step, with
+  // and without a linear band in the starting field (then the first step is general),
+  // over fixed and auto steps. Same arithmetic up to float rounding: 1e-5 of the
+  // brightest cell, the same step count and per-step energies within 1e-5.
+  struct Case {
+    const char* name;
+    bool heterogeneous, lobes;
+  };
+  for (const Case& c : {Case{"heterogeneous", true, false}, Case{"heterogeneous with lobes", true, true},
+                        Case{"dense", false, false}}) {
+    const Ball ball = ballCase(18, c.heterogeneous, c.lobes, c.lobes ? 7u : 3u);
+    const StepFactors factors = computeStepFactors(ball.material, LpvScheme::Calibrated, 1.4);
+    if (c.heterogeneous) {
+      ASSERT_FALSE(factors.conductance[0].empty()) << c.name << ": the case must exercise the varying D";
+    } else {
+      const auto [low, high] = std::minmax_element(factors.retention[1].begin(), factors.retention[1].end());
+      ASSERT_LT(*low, 0.0f) << c.name << ": the case must exercise negative retention";
+      ASSERT_GT(*high, 0.0f) << c.name;
+    }
+    for (bool autoSteps : {false, true}) {
+      PropagationOptions options;
+      options.steps = 150;
+      options.autoSteps = autoSteps;
+      options.recordEnergy = true;
+      const auto run = [&](bool fast) {
+        LobeRun r;
+        r.field = ball.injected;
+        r.accumulated.resize(ball.material.frame);
+        PropagationOptions o = options;
+        o.isotropicFastPath = fast;
+        r.result = propagate(ball.material, factors, r.field, r.accumulated, o);
+        return r;
+      };
+      const LobeRun fast = run(true), general = run(false);
+      const std::string name = std::string(c.name) + ", " + (autoSteps ? "auto" : "150") + " steps";
+      ASSERT_EQ(fast.result.stepsRun, general.result.stepsRun) << name;
+      ASSERT_GT(fast.result.stepsRun, 20) << name;
+      for (int ch = 0; ch < 3; ++ch) {
+        const std::vector<float>& expected = general.accumulated.planes[std::size_t(ch) * 4];
+        const std::vector<float>& actual = fast.accumulated.planes[std::size_t(ch) * 4];
+        const float brightest = *std::max_element(expected.begin(), expected.end());
+        ASSERT_GT(brightest, 0.0f);
+        float worst = 0.0f;
+        for (std::size_t i = 0; i < expected.size(); ++i) worst = std::max(worst, std::abs(actual[i] - expected[i]));
+        EXPECT_LT(worst, 1e-5f * brightest) << name << ", channel " << ch;
+        for (int k = 1; k < 4; ++k)
+          EXPECT_EQ(fast.accumulated.planes[std::size_t(ch) * 4 + std::size_t(k)],
+                    general.accumulated.planes[std::size_t(ch) * 4 + std::size_t(k)])
+              << name;
+        EXPECT_NEAR(fast.result.tailScale[ch], general.result.tailScale[ch],
+                    1e-3 * (1.0 + general.result.tailScale[ch])) << name;
+        for (std::size_t k = 0; k < fast.result.energy.size(); ++k) {
+          const double scale = fast.result.initialPower[ch];
+          EXPECT_NEAR(fast.result.energy[k].inGrid[ch], general.result.energy[k].inGrid[ch], 1e-5 * scale) << name;
+          EXPECT_NEAR(fast.result.energy[k].absorbed[ch], general.result.energy[k].absorbed[ch], 1e-5 * scale) << name;
+          EXPECT_NEAR(fast.result.energy[k].left[ch], general.result.energy[k].left[ch], 1e-5 * scale) << name;
+        }
+      }
+    }
+  }
+}
+
+TEST(Propagation, SeedStepsNeverTakeTheIsotropicPath) {
+  // The seed scheme keeps a linear band (its linear factors are not 0): an isotropic start
+  // must still propagate through the general step, which turns it anisotropic at the
+  // boundary. Switching the fast path off changes nothing.
+  const Ball ball = ballCase(12, true, false, 11u);
+  const StepFactors factors = computeStepFactors(ball.material, LpvScheme::Seed, 1.4);
+  const auto run = [&](bool fast) {
+    LobeRun r;
+    r.field = ball.injected;
+    r.accumulated.resize(ball.material.frame);
+    PropagationOptions o;
+    o.steps = 12;
+    o.isotropicFastPath = fast;
+    r.result = propagate(ball.material, factors, r.field, r.accumulated, o);
+    return r;
+  };
+  const LobeRun fast = run(true), general = run(false);
+  EXPECT_EQ(fast.accumulated.planes, general.accumulated.planes);
+  bool anisotropic = false;
+  for (float c : fast.accumulated.planes[1]) anisotropic = anisotropic || c != 0.0f;
+  EXPECT_TRUE(anisotropic);
 }
 
 TEST(GridFrame, TooLargeAGridIsAClearResourceError) {

@@ -30,6 +30,12 @@
 
 #define SSLPV_PI 3.14159265358979323846
 
+// Of an isotropic cell's c0, the share each of its six neighbours receives per step (in
+// their c0): its power split six ways, re-emitted as a cosine lobe,
+// C0 / pi * FLUX_PER_C0 / 6 = 1/6. Used where a scheme's steps keep every cell isotropic
+// (volume/propagate.cpp, shaders/lpv_transfer.glsl).
+#define SSLPV_ISOTROPIC_NEIGHBOUR_SHARE (SSLPV_COSINE_LOBE_C0 / SSLPV_PI * SSLPV_FLUX_PER_C0 / 6.0)
+
 // --steps auto: a channel whose step holds less than this fraction of its accumulated
 // power has converged as far as float sums can tell. Its decay ratio is then rounding
 // noise (on lavapipe, denormals that stall at a ratio of 1), so it neither holds up the

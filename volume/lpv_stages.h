@@ -89,6 +89,10 @@ struct PropagationOptions {
   double autoTailTolerance = 1e-2;
   int maxAutoSteps = 10000;
   bool recordEnergy = false;  ///< fill PropagationResult::energy for every step
+  /// Steps of an isotropic field under a scheme that keeps it isotropic (the calibrated
+  /// one) as a stencil on c0 alone: the same light up to float rounding, about 4x faster.
+  /// Off only to compare with the general step.
+  bool isotropicFastPath = true;
 };
 
 struct PropagationResult {
@@ -147,6 +151,11 @@ struct StepFactors {
 };
 StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme = LpvScheme::Seed,
                                double ior = 1.0);
+
+/// Do the factors' steps leave every cell isotropic (all linear factors 0, as in the
+/// calibrated scheme)? Then every step after the first is a stencil on c0 alone, which
+/// both backends run as such (PropagationOptions::isotropicFastPath).
+bool keepsCellsIsotropic(const StepFactors& factors);
 
 /// Beyond this ratio between the largest and the smallest diffusion coefficient of a
 /// grid's cells (per channel), the densest cells pass light faster than their own D: the
