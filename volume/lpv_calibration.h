@@ -11,6 +11,8 @@
 //  1. Resets the linear band every step (light in a cell is re-emitted isotropically),
 //     which makes propagation an exact lattice random walk: from a laterally uniform
 //     layer, 1/6 of a step's power moves up, 1/6 down and 4/6 stays in the layer.
+//     With isotropic injection no cell ever holds a linear band, so both backends run
+//     the steps after the first as a stencil on c0 (keepsCellsIsotropic).
 //  2. Picks the DC survival s per step so that the walk decays with depth exactly as
 //     transport in the medium does far from sources and boundaries, exp(-κ z): κ is the
 //     asymptotic decay constant of radiative transport, α' atanh(κ/σt') / (κ/σt') = 1
