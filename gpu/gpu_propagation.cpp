@@ -3,11 +3,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <functional>
 #include <string>
-#include <thread>
 
+#include "gpu/propagation_items.h"
 #include "volume/error.h"
 #include "volume/sh.h"
 
@@ -24,12 +23,6 @@ constexpr VkDeviceSize kEnergyRowBytes = SSLPV_ENERGY_FLOATS * sizeof(float);
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 constexpr VkBufferUsageFlags kField = kStorage | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-// Tile rows picked automatically, and the measured cost of a covered cell with 8 rows
-// relative to 4 rows on lavapipe (64^3 cube, sphere and shell, bench/gpu_propagation_bench
-// --rows 4|8: 0.87-0.92; fewer halo rows per tile against more covered cells).
-constexpr int kNarrowRows = 4, kWideRows = 8;
-constexpr double kWideRowCost = 0.9;
-
 glm::dvec3 gridPower(const ShGrid& grid) {
   glm::dvec3 power(0.0);
   for (int ch = 0; ch < 3; ++ch) {
@@ -96,41 +89,6 @@ VkBufferView makeTexelView(const VulkanDevice& device, const Buffer& buffer) {
   return view;
 }
 
-/// Threads that run a dispatch's workgroups: lavapipe's compute pool has LP_NUM_THREADS
-/// or one per core; a GPU has far more lanes than items, so 1 disables balancing.
-std::size_t workerThreads(const VulkanDevice& device) {
-  if (device.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return 1;
-  if (const char* env = std::getenv("LP_NUM_THREADS")) return std::max(1, std::atoi(env));
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
-/// Orders items for lavapipe's compute pool, which splits a dispatch STATICALLY: with T
-/// threads, each takes one run of N / T consecutive workgroups, then the N % T left take
-/// one each. Dealing the items, longest first, to T equal-count bins in snake order
-/// balances the runs' work; each bin keeps raster order, so a thread's consecutive tiles
-/// share halo rows in its cache.
-std::vector<LpvItem> balanceItems(std::vector<LpvItem> items, std::size_t threads) {
-  const std::size_t perBin = items.size() / threads;
-  if (threads < 2 || perBin == 0) return items;
-  std::vector<std::size_t> order(items.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return items[a].zEnd - items[a].zBegin > items[b].zEnd - items[b].zBegin;
-  });
-  std::vector<std::vector<std::size_t>> bins(threads);
-  std::size_t next = 0;
-  for (std::size_t round = 0; round < perBin; ++round)
-    for (std::size_t k = 0; k < threads; ++k) bins[round % 2 ? threads - 1 - k : k].push_back(order[next++]);
-  std::vector<LpvItem> balanced;
-  balanced.reserve(items.size());
-  for (std::vector<std::size_t>& bin : bins) {
-    std::sort(bin.begin(), bin.end());  // raster order: items were built tile by tile
-    for (std::size_t i : bin) balanced.push_back(items[i]);
-  }
-  for (; next < order.size(); ++next) balanced.push_back(items[order[next]]);  // the shortest
-  return balanced;
-}
-
 /// Makes compute writes visible to every later read (shading, copies, the host).
 void toLaterReadsBarrier(VkCommandBuffer cmd) {
   VkMemoryBarrier barrier{};
@@ -142,33 +100,6 @@ void toLaterReadsBarrier(VkCommandBuffer cmd) {
                        nullptr);
 }
 
-/// Per tile of SSLPV_TILE_X x rows cells and slice: does it hold an active cell? Indexed
-/// (z * tilesY + tileY) * tilesX + tileX.
-std::vector<unsigned char> occupiedSlabs(const GridFrame& frame, const StepFactors& factors, int rows) {
-  const glm::ivec3 d = frame.dims;
-  const int tilesX = (d.x + SSLPV_TILE_X - 1) / SSLPV_TILE_X, tilesY = (d.y + rows - 1) / rows;
-  std::vector<unsigned char> slab(std::size_t(tilesX) * tilesY * std::max(d.z, 0), 0);
-  tbb::parallel_for(0, std::max(d.z, 0), [&](int z) {
-    for (int y = 0; y < d.y; ++y) {
-      if (!factors.rowActive[std::size_t(z) * d.y + y]) continue;
-      for (int x = 0; x < d.x; ++x)
-        if (factors.active[frame.index(x, y, z)])
-          slab[(std::size_t(z) * tilesY + y / rows) * tilesX + x / SSLPV_TILE_X] = 1;
-    }
-  });
-  return slab;
-}
-
-/// Wide tiles re-read fewer halo rows, narrow ones cover fewer empty cells around a thin
-/// or curved object: the cheaper by covered cells and the measured cost ratio.
-int chooseTileRows(const GridFrame& frame, const StepFactors& factors) {
-  const auto covered = [&](int rows) {
-    const std::vector<unsigned char> slab = occupiedSlabs(frame, factors, rows);
-    return double(std::count(slab.begin(), slab.end(), 1)) * SSLPV_TILE_X * rows;
-  };
-  return kWideRowCost * covered(kWideRows) <= covered(kNarrowRows) ? kWideRows : kNarrowRows;
-}
-
 }  // namespace
 
 GpuPropagator::GpuPropagator(const VulkanDevice& device, const GridFrame& frame, const StepFactors& factors,
@@ -178,7 +109,7 @@ GpuPropagator::GpuPropagator(const VulkanDevice& device, const GridFrame& frame,
   const bool factorsFit = factors.active.size() == frame.cellCount() &&
                           factors.rowActive.size() == std::size_t(frame.dims.y) * frame.dims.z;
   if (options_.tileRows <= 0)  // factors that do not fit are rejected by setFactors() below
-    options_.tileRows = factorsFit ? chooseTileRows(frame, factors) : kWideRows;
+    options_.tileRows = factorsFit ? chooseTileRows(frame, factors) : kWideTileRows;
   if (options_.tileRows > 32 || options_.stepsPerSubmission < 1 || options_.zChunk < 0)
     throw GpuError("GpuPropagatorOptions: tileRows must be 1..32, stepsPerSubmission >= 1, zChunk >= 0");
 
@@ -246,42 +177,11 @@ GpuPropagator::GpuPropagator(const VulkanDevice& device, const GridFrame& frame,
 }
 
 void GpuPropagator::buildItems(const StepFactors& factors) {
-  const glm::ivec3 d = frame_.dims;
-  const int rows = options_.tileRows;
-  const int tilesX = tilesX_, tilesY = tilesY_;
-  const std::vector<unsigned char> slab = occupiedSlabs(frame_, factors, rows);
-  const auto occupied = std::size_t(std::count(slab.begin(), slab.end(), 1));
+  ItemPlan plan = planItems(frame_, factors, options_.tileRows, options_.zChunk, workerThreads(device_));
+  std::vector<LpvItem> items = std::move(plan.items);
+  zChunk_ = plan.zChunk;
+  coveredCells_ = plan.coveredCells;
   activeCells_ = std::size_t(std::count(factors.active.begin(), factors.active.end(), 1));
-
-  // Enough items for every worker of the device, without splitting runs so finely that
-  // the 2 halo slices each piece re-reads dominate.
-  const std::size_t workers = workerThreads(device_);
-  zChunk_ = options_.zChunk > 0 ? options_.zChunk
-                                : int(std::clamp<std::size_t>((occupied + 8 * workers - 1) / (8 * workers), 4,
-                                                              std::size_t(std::max(d.z, 4))));
-  std::vector<LpvItem> items;
-  coveredCells_ = 0;
-  for (int ty = 0; ty < tilesY; ++ty)
-    for (int tx = 0; tx < tilesX; ++tx)
-      for (int z = 0; z < d.z;) {
-        if (!slab[(std::size_t(z) * tilesY + ty) * tilesX + tx]) {
-          ++z;
-          continue;
-        }
-        int end = z;
-        while (end < d.z && slab[(std::size_t(end) * tilesY + ty) * tilesX + tx]) ++end;
-        // Split the run into near-equal pieces of at most zChunk_ slices.
-        const int pieces = (end - z + zChunk_ - 1) / zChunk_;
-        for (int p = 0; p < pieces; ++p) {
-          const int begin = z + (end - z) * p / pieces, stop = z + (end - z) * (p + 1) / pieces;
-          items.push_back(LpvItem{std::uint32_t(tx * SSLPV_TILE_X), std::uint32_t(ty * rows), std::uint32_t(begin),
-                                  std::uint32_t(stop)});
-          const int width = std::min(SSLPV_TILE_X, d.x - tx * SSLPV_TILE_X), height = std::min(rows, d.y - ty * rows);
-          coveredCells_ += std::size_t(width) * height * (stop - begin);
-        }
-        z = end;
-      }
-  items = balanceItems(std::move(items), workerThreads(device_));
   if (items.size() > device_.properties().limits.maxComputeWorkGroupCount[0])
     throw ResourceError("LPV grid needs more work items than the Vulkan device dispatches at once");
 
