@@ -279,11 +279,14 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
   }
   active_ = factors.active;
   isotropicSteps_ = options_.isotropicSteps && keepsCellsIsotropic(factors);
-  if (isotropicSteps_ && isotropicPipelines_[0].pipeline() == VK_NULL_HANDLE)
+  if (isotropicSteps_ && isotropicPipelines_[0].pipeline() == VK_NULL_HANDLE) {
+    const auto rows = std::uint32_t(options_.tileRows);
     for (std::uint32_t variant = 0; variant < 2; ++variant)
       isotropicPipelines_[variant] = ComputePipeline(device_, spirv::lpv_propagate_comp(), setLayout_.get(),
-                                                     sizeof(LpvStepPush),
-                                                     {std::uint32_t(options_.tileRows), variant, 1u});
+                                                     sizeof(LpvStepPush), {rows, variant, 1u, 0u});
+    chebyshevPipeline_ = ComputePipeline(device_, spirv::lpv_propagate_comp(), setLayout_.get(), sizeof(LpvStepPush),
+                                         {rows, 0u, 1u, 1u});
+  }
   freshGain_ = factors.freshGain;
   buildItems(factors);
 }
@@ -368,6 +371,7 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
                                 const PropagationOptions& options, bool timestamps) {
   LpvStepPush push = stepPush(options);
   const auto groups = std::uint32_t(itemCount_);
+  const bool chebyshev = chebyshevRun(mode, options);
   for (int s = 0; s < count; ++s) {
     const int step = firstStep + s;
     push.stepSlot = s % options_.stepsPerSubmission;
@@ -380,7 +384,17 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
     // Step 0 reads the injected light, which may hold a linear band; after it, factors
     // that keep cells isotropic have left none.
     const ComputePipeline* pipelines = isotropicSteps_ && step > 0 ? isotropicPipelines_ : propagatePipelines_;
-    pipelines[push.accumulate != 0].bind(cmd, sets_[step % 2], &push, sizeof(push));
+    const ComputePipeline* pipeline = &pipelines[push.accumulate != 0];
+    if (chebyshev) {
+      // Step 0 leaves its light alone in the accumulated grid (y) and makes no stop
+      // decision; then the probe steps and the iterates, which accumulate nothing
+      // (runChebyshev on the CPU).
+      push.autoSteps = step == 0 ? 0 : 1;
+      push.chebyshev = step == 0 ? 0 : step <= SSLPV_CHEBYSHEV_PROBE_STEPS ? 1 : 2;
+      push.accumulate = step == 0 ? 3 : 0;
+      pipeline = step == 0 ? &propagatePipelines_[1] : &chebyshevPipeline_;
+    }
+    pipeline->bind(cmd, sets_[step % 2], &push, sizeof(push));
     if (groups > 0) vkCmdDispatch(cmd, groups, 1, 1);
     computeToComputeBarrier(cmd);
     if (timestamps) timestamps_.write(cmd, 1 + 2 * std::uint32_t(s));
@@ -391,9 +405,14 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
   }
 }
 
+bool GpuPropagator::chebyshevRun(Mode mode, const PropagationOptions& options) const {
+  return mode == Mode::Device && options.chebyshev && options.autoSteps && isotropicSteps_;
+}
+
 void GpuPropagator::recordFinish(VkCommandBuffer cmd, Mode mode, int stepLimit, const PropagationOptions& options) {
   if (itemCount_ == 0) return;
   LpvStepPush push = stepPush(options);
+  push.chebyshev = chebyshevRun(mode, options) ? 1 : 0;
   // The last step is missing from the accumulated grid when it did not accumulate: from
   // the host odd steps accumulate, so the last one (index stepsRun - 1) is missing when
   // stepsRun is odd and its light is in tiled_[1]; on the device even steps do, so it is
@@ -447,7 +466,8 @@ PropagationResult GpuPropagator::execute(Mode mode, const PropagationOptions& op
     for (int s = 0; s < ran; ++s) {
       timings_.propagateMs += ms[1 + 2 * s] - ms[2 * s];
       timings_.reduceMs += ms[2 + 2 * s] - ms[1 + 2 * s];
-      if (!options.recordEnergy) continue;
+      // The Chebyshev iterates' sums are not energies; the CPU records none for them.
+      if (!options.recordEnergy || (chebyshevRun(mode, options) && stepsBefore + s > 0)) continue;
       const float* row = totals + std::size_t(s) * SSLPV_ENERGY_FLOATS;
       StepEnergy e;
       for (int ch = 0; ch < 3; ++ch) {

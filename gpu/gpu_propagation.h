@@ -127,6 +127,9 @@ class GpuPropagator {
   LpvStepPush stepPush(const PropagationOptions& options) const;
   void recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, int count, const PropagationOptions& options,
                    bool timestamps);
+  /// Does this run take the Chebyshev iterates (device-resident auto steps on factors
+  /// that keep cells isotropic, PropagationOptions::chebyshev)?
+  bool chebyshevRun(Mode mode, const PropagationOptions& options) const;
   void recordFinish(VkCommandBuffer cmd, Mode mode, int stepLimit, const PropagationOptions& options);
   void prepareDeviceRun(VkCommandBuffer cmd);
   PropagationResult execute(Mode mode, const PropagationOptions& options);
@@ -150,6 +153,7 @@ class GpuPropagator {
   /// The same for the steps after the first where the factors keep cells isotropic
   /// (keepsCellsIsotropic), built on first need.
   ComputePipeline isotropicPipelines_[2];
+  ComputePipeline chebyshevPipeline_;  ///< the Chebyshev iterates, built with the above
   bool isotropicSteps_ = false;
   ComputePipeline finishPipelines_[2];      ///< into tiled_ / linear accumulated light
   ComputePipeline reducePipeline_, importPipeline_;

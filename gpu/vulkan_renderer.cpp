@@ -155,6 +155,7 @@ Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOu
     PropagationOptions options;
     options.steps = settings.steps;
     options.autoSteps = settings.autoSteps;
+    options.chebyshev = true;
     report.propagation = propagator_->runOnDevice(options);
     const GpuPropagationTimings& t = propagator_->timings();
     report.times.propagation = t.propagateMs + t.reduceMs;

@@ -38,6 +38,13 @@ layout(constant_id = 1) const int ACCUMULATE = 0;
 /// 1: the source field has no linear band and the step factors keep it so (the calibrated
 /// scheme after its first step): emitIsotropicChannel instead of the clamped faces.
 layout(constant_id = 2) const int ISOTROPIC = 0;
+/// 1 (with ISOTROPIC 1, ACCUMULATE 0): a Chebyshev iterate x_{k+1} = ω (T x_k + y - x_{k-1})
+/// + x_{k-1} of a device-resident auto run (chebyshevSlice on the CPU): the source field
+/// is x_k, the destination holds x_{k-1} and receives x_{k+1} (each cell reads its own
+/// value before writing it), the accumulated light holds y, the first step's light, and
+/// ω comes from the control record (lpv_reduce.comp); a probe step is the same with
+/// ω = 1 and no y. The sums carry Σ |x_{k+1} - x_k| as gathered and Σ x_{k+1} as kept.
+layout(constant_id = 3) const int CHEBYSHEV = 0;
 
 const int W = SSLPV_TILE_X;
 const int HALF = SSLPV_TILE_X / 2;
@@ -76,7 +83,7 @@ CellLobes emitCell(int x, int y, int z, float owned, inout StepSums sums) {
   vec3 emitted = vec3(0.0), clampRemoved = vec3(0.0);
   for (int ch = 0; ch < 3; ++ch) {
     if (ISOTROPIC != 0)
-      lobes.ch[ch] = emitIsotropicChannel(raw.c[ch], conductance[ch], emitted[ch]);
+      lobes.ch[ch] = emitIsotropicChannel(raw.c[ch], conductance[ch], CHEBYSHEV != 0, emitted[ch]);
     else
       lobes.ch[ch] = emitChannel(raw.c[ch], conductance[ch], emitted[ch], clampRemoved[ch]);
   }
@@ -107,6 +114,21 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
   const vec3 conductance = texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 4).xyz;
   const float on = dc.w;
   vec4 value[3];
+  if (CHEBYSHEV != 0) {
+    // Probe steps (push.chebyshev 1) are plain linear steps: weight 1, no source.
+    const bool probe = push.chebyshev == 1;
+    const vec3 omega = probe ? vec3(1.0) : vec3(control.omegaR, control.omegaG, control.omegaB);
+    for (int ch = 0; ch < 3; ++ch) {
+      const float older = texelFetch(otherField, 3 * i + ch).x;
+      const float current = texelFetch(sourceField, 3 * i + ch).x;
+      const float y = probe ? 0.0 : texelFetch(accumulatedIn, 3 * i + ch).x;
+      const float next = on * (omega[ch] * (conductance[ch] * gathered.c[ch].x * dc[ch] + y - older) + older);
+      destination[3 * i + ch] = vec4(next, 0.0, 0.0, 0.0);
+      sums.gathered[ch] += abs(next - current);
+      sums.kept[ch] += next;
+    }
+    return;
+  }
   for (int ch = 0; ch < 3; ++ch) {
     gathered.c[ch] *= conductance[ch];
     value[ch] = on * gathered.c[ch] * vec4(dc[ch], linear[ch], linear[ch], linear[ch]);
@@ -120,8 +142,12 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
     // it never holds a NaN.
     const float keep = push.accumulate == 1 ? 1.0 : 0.0;
     // Step 0 of a device-resident run: its source is the injected light, which enters the
-    // accumulated light times the fresh gain (addInjected on the CPU).
-    const vec3 sourceGain = push.accumulate == 2 ? texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 3).xyz : vec3(1.0);
+    // accumulated light times the fresh gain (addInjected on the CPU). Before Chebyshev
+    // iterates (3) the accumulated light holds this step's alone, their y; the finish
+    // adds the injected light.
+    const vec3 sourceGain = push.accumulate == 2   ? texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 3).xyz
+                            : push.accumulate == 3 ? vec3(0.0)
+                                                   : vec3(1.0);
     for (int ch = 0; ch < 3; ++ch)
       accumulated[3 * i + ch] =
           keep * texelFetch(accumulatedIn, 3 * i + ch) + sourceGain[ch] * texelFetch(sourceField, 3 * i + ch) + value[ch];

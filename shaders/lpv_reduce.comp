@@ -23,6 +23,13 @@ layout(std430, binding = 8) writeonly buffer StepTotals { vec4 totals[]; };
 // One entry per subgroup (at least 1 lane per subgroup; the group is small).
 shared vec4 subgroupTotals[SSLPV_ENERGY_VEC4S][SSLPV_REDUCE_GROUP];
 
+/// chebyshevOmega() and chebyshevRate() of volume/propagate.cpp, in float.
+float chebyshevOmega(int k, float rho) {
+  if (!(rho > 0.0) || k < 1) return 1.0;
+  return 2.0 / (1.0 + tanh(float(k) * acosh(1.0 / rho)) * sqrt(1.0 - rho * rho));
+}
+float chebyshevRate(float rho) { return rho > 0.0 ? rho / (1.0 + sqrt(max(0.0, 1.0 - rho * rho))) : 0.0; }
+
 void main() {
   const int stopped = control.stopped;
   const uint li = gl_LocalInvocationIndex;
@@ -44,6 +51,56 @@ void main() {
     totals[SSLPV_ENERGY_VEC4S * push.stepSlot + k] = row[k];
   }
 
+  if (push.chebyshev != 0) {
+    // runChebyshev() on the CPU.
+    control.stepsRun += 1;
+    const vec3 change = vec3(row[1].zw, row[2].x);                     // SSLPV_ENERGY_GATHERED
+    const vec3 total = row[3].xyz * float(SSLPV_FLUX_PER_C0);          // SSLPV_ENERGY_IN_GRID
+    vec3 rho = vec3(control.rhoR, control.rhoG, control.rhoB);
+    if (push.chebyshev == 1) {
+      // A probe step: the ratio of its power to the last one's estimates the radius.
+      const vec3 previous = vec3(control.previousInGridR, control.previousInGridG, control.previousInGridB);
+      for (int ch = 0; ch < 3; ++ch)
+        rho[ch] = previous[ch] > 0.0 ? clamp(total[ch] / previous[ch], 0.0, float(SSLPV_CHEBYSHEV_MAX_RHO)) : 0.0;
+      control.previousInGridR = total.r;
+      control.previousInGridG = total.g;
+      control.previousInGridB = total.b;
+      control.rhoR = rho.r;
+      control.rhoG = rho.g;
+      control.rhoB = rho.b;
+      control.omegaR = control.omegaG = control.omegaB = 1.0;  // the first iterate's
+      return;
+    }
+    const int k = control.iterates + 1;
+    control.iterates = k;
+    const vec3 lastChange = vec3(control.lastChangeR, control.lastChangeG, control.lastChangeB);
+    vec3 logShrink = vec3(control.logShrinkR, control.logShrinkG, control.logShrinkB);
+    bool converged = k > SSLPV_CHEBYSHEV_RATE_WINDOW;
+    vec3 omega;
+    for (int ch = 0; ch < 3; ++ch) {
+      omega[ch] = chebyshevOmega(k, rho[ch]);
+      if (k > 1 && lastChange[ch] > 0.0 && change[ch] > 0.0)
+        logShrink[ch] += (log(change[ch] / lastChange[ch]) - logShrink[ch]) / float(SSLPV_CHEBYSHEV_RATE_WINDOW);
+      // chebyshevConverged(): the light still to come, the change times rate / (1 - rate)
+      // at the larger of the theoretical and the observed shrink, under autoTolerance of
+      // the total, or the change float noise.
+      const float chTotal = row[3][ch];
+      if (!(chTotal > 0.0) || !(change[ch] > float(SSLPV_AUTO_STEP_NEGLIGIBLE) * chTotal)) continue;
+      const float rate = max(chebyshevRate(rho[ch]), min(exp(logShrink[ch]), float(SSLPV_CHEBYSHEV_MAX_RHO)));
+      if (!(change[ch] * rate / (1.0 - rate) < push.autoTolerance * chTotal)) converged = false;
+    }
+    control.lastChangeR = change.r;
+    control.lastChangeG = change.g;
+    control.lastChangeB = change.b;
+    control.logShrinkR = logShrink.r;
+    control.logShrinkG = logShrink.g;
+    control.logShrinkB = logShrink.b;
+    control.omegaR = omega.r;
+    control.omegaG = omega.g;
+    control.omegaB = omega.b;
+    if (converged) control.stopped = 1;
+    return;
+  }
   const vec3 inGrid = row[3].xyz * float(SSLPV_FLUX_PER_C0);                          // SSLPV_ENERGY_IN_GRID
   const vec3 source = vec3(row[3].w, row[4].xy) * float(SSLPV_FLUX_PER_C0);           // SSLPV_ENERGY_SOURCE
   vec3 accumulatedPower = vec3(control.accumulatedPowerR, control.accumulatedPowerG, control.accumulatedPowerB);

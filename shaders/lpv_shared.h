@@ -5,6 +5,8 @@
 #ifndef SSLPV_LPV_SHARED_H
 #define SSLPV_LPV_SHARED_H
 
+#include "volume/lpv_constants.h"
+
 #ifdef __cplusplus
 #include <cstddef>
 #include <cstdint>
@@ -50,10 +52,11 @@ namespace sslpv::gpu {
   X(int, autoSteps)      /* 1: stop once a step adds < tolerance of accumulated power */  \
   X(float, autoTolerance)                                                                  \
   X(int, initPower)      /* 1: this step's source power starts the accumulated power */   \
-  X(int, accumulate)     /* 0: no; 1: accumulated += source + result; 2: = freshGain source + result */ \
+  X(int, accumulate)     /* 0: no; 1: accumulated += source + result; 2: = freshGain source + result; 3: = result */ \
   X(int, leftoverParity) /* the accumulation kernel adds the last field if stepsRun % 2 is this */ \
   X(int, stepLimit)      /* ... once stepsRun reaches this or auto steps stopped */       \
-  X(float, autoTailTolerance) /* and the estimated power still to come is below this */
+  X(float, autoTailTolerance) /* and the estimated power still to come is below this */ \
+  X(int, chebyshev)      /* PropagationOptions::chebyshev: 1 a probe step, 2 an iterate */
 
 struct LpvStepPush {
   SSLPV_LPV_STEP_PUSH_FIELDS(SSLPV_DECLARE_FIELD)
@@ -77,7 +80,20 @@ struct LpvStepPush {
   X(float, tailScaleR)              \
   X(float, tailScaleG)              \
   X(float, tailScaleB)              \
-  X(SSLPV_UINT, pad0)
+  X(SSLPV_UINT, pad0)               \
+  X(float, rhoR)     /* Chebyshev: the probe's spectral radius estimate */ \
+  X(float, rhoG)                    \
+  X(float, rhoB)                    \
+  X(float, omegaR)   /* the next iterate's weight */ \
+  X(float, omegaG)                  \
+  X(float, omegaB)                  \
+  X(int, iterates)                  \
+  X(float, lastChangeR) /* the last iterate's change */ \
+  X(float, lastChangeG)             \
+  X(float, lastChangeB)             \
+  X(float, logShrinkR)  /* running mean of log(change / last change) */ \
+  X(float, logShrinkG)              \
+  X(float, logShrinkB)
 
 struct LpvControl {
   SSLPV_LPV_CONTROL_FIELDS(SSLPV_DECLARE_FIELD)
@@ -113,9 +129,9 @@ struct LpvItem {
 
 #ifdef __cplusplus
 }  // namespace sslpv::gpu
-static_assert(sizeof(sslpv::gpu::LpvStepPush) == 12 * 4, "LpvStepPush must be 4-byte scalars only");
+static_assert(sizeof(sslpv::gpu::LpvStepPush) == 13 * 4, "LpvStepPush must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::LpvStepPush, autoTolerance) == 6 * 4, "LpvStepPush field order");
-static_assert(sizeof(sslpv::gpu::LpvControl) == 12 * 4, "LpvControl must be 4-byte scalars only");
+static_assert(sizeof(sslpv::gpu::LpvControl) == 25 * 4, "LpvControl must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::LpvControl, accumulatedPowerR) == 2 * 4, "LpvControl field order");
 static_assert(sizeof(sslpv::gpu::LpvItem) == 4 * 4, "LpvItem is one uvec4");
 #endif

@@ -79,10 +79,11 @@ Lobes emitChannel(vec4 c, float conductance, inout float emitted, inout float cl
 /// emitChannel for a cell without linear band under a scheme whose steps keep it so (the
 /// calibrated one, after its first step): every lobe is the same and no face clamps, so
 /// each neighbour gets kIsotropicShare of the cell's c0 (a cell driven below zero sends
-/// nothing). gatherSliceIsotropic on the CPU. The clamp removes nothing.
+/// nothing, unless `linear`: the Chebyshev iterates, chebyshevSlice on the CPU).
+/// gatherSliceIsotropic on the CPU. The clamp removes nothing.
 const float kIsotropicShare = float(SSLPV_ISOTROPIC_NEIGHBOUR_SHARE);
-Lobes emitIsotropicChannel(vec4 c, float conductance, inout float emitted) {
-  const float light = max(0.0, c.x);
+Lobes emitIsotropicChannel(vec4 c, float conductance, bool linear, inout float emitted) {
+  const float light = linear ? c.x : max(0.0, c.x);
   emitted += light * kFluxPerC0;
   const vec4 lobe = vec4(kIsotropicShare * conductance * light, 0.0, 0.0, 0.0);
   Lobes lobes;

@@ -381,6 +381,62 @@ TEST_F(GpuPropagation, DeviceResidentRunsEqualTheHostRun) {
   reportWorst("DeviceResidentRunsEqualTheHostRun");
 }
 
+TEST_F(GpuPropagation, ChebyshevAutoStepsOnTheDeviceMatchTheCpu) {
+  // --steps auto as the semi-iteration (PropagationOptions::chebyshev), device-resident
+  // through runOnDevice() and record(), against the CPU: the same steps (probe, iterates
+  // and stop, decided on the GPU in float), the first step's energy, the accumulated
+  // light and the last iterate. Calibrated sphere and shell (retention, conductance,
+  // fresh gain) with isotropic injected light, as the calibrated injection writes it
+  // (see CalibratedSphereAndShellWithBoundaryRetentionMatchCpu); a few steps per
+  // submission, so that the iterates' weights and the stop carry across submissions.
+  std::mt19937 rng(23);
+  for (const bool shell : {false, true}) {
+    RandomCase c = shapedCase(glm::ivec3(21, 18, 23), shell, rng);
+    for (int ch = 0; ch < 3; ++ch)
+      for (int k = 1; k < 4; ++k)
+        std::fill(c.injected.plane(ch, k), c.injected.plane(ch, k) + c.material.frame.cellCount(), 0.0f);
+    const StepFactors factors = computeStepFactors(c.material, LpvScheme::Calibrated, 1.4);
+    PropagationOptions options = stepsWithEnergy(0);
+    options.autoSteps = true;
+    options.chebyshev = true;
+    PropagationOptions plain = options;
+    plain.chebyshev = false;
+    const std::string what = shell ? "shell" : "sphere";
+    const Outcome cpu = runCpu(c.material, c.injected, options, LpvScheme::Calibrated);
+    const int plainSteps = runCpu(c.material, c.injected, plain, LpvScheme::Calibrated).result.stepsRun;
+    ASSERT_GT(cpu.result.stepsRun, SSLPV_CHEBYSHEV_PROBE_STEPS + SSLPV_CHEBYSHEV_RATE_WINDOW) << what;
+    EXPECT_LT(cpu.result.stepsRun, plainSteps) << what << ": the semi-iteration must take fewer steps";
+
+    gpu::GpuPropagatorOptions gpuOptions;
+    gpuOptions.stepsPerSubmission = 5;
+    gpu::GpuPropagator devicePath(device(), c.material.frame, factors, gpuOptions);
+    Outcome onDevice;
+    onDevice.field.resize(c.material.frame);
+    onDevice.accumulated.resize(c.material.frame);
+    devicePath.uploadField(c.injected, devicePath.sourceField(), true);
+    onDevice.result = devicePath.runOnDevice(options);
+    devicePath.downloadField(devicePath.accumulated(), onDevice.accumulated);
+    devicePath.downloadLastField(onDevice.field);
+    expectRunsMatch(onDevice, cpu, what + " on the device", kDevicePowerTolerance);
+
+    gpu::GpuPropagator recordPath(device(), c.material.frame, factors, gpuOptions);
+    recordPath.uploadField(c.injected, recordPath.sourceField(), true);
+    gpu::CommandContext commands(device());
+    recordPath.record(commands.begin(), options);
+    commands.submitAndWait();
+    EXPECT_EQ(recordPath.stepsRun(), cpu.result.stepsRun) << what << " recorded";
+    ShGrid recorded;
+    recorded.resize(c.material.frame);
+    recordPath.downloadField(recordPath.accumulated(), recorded);
+    expectGridsMatch(recorded, cpu.accumulated, what + " recorded, accumulated");
+
+    // From host grids the propagator keeps the plain steps (run() keeps no y).
+    const Outcome host = runGpu(device(), c.material, c.injected, options, {}, LpvScheme::Calibrated);
+    EXPECT_EQ(host.result.stepsRun, plainSteps) << what << " from the host";
+  }
+  reportWorst("ChebyshevAutoStepsOnTheDeviceMatchTheCpu");
+}
+
 TEST_F(GpuPropagation, TileRowsZChunksAndStagingGiveTheSameResult) {
   // Results must not depend on how the grid is cut into work items (halo seams between
   // tiles and between the z pieces of a run) or on how data reaches the device; 2 steps

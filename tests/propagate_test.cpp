@@ -408,6 +408,114 @@ TEST(Propagation, CalibratedIsotropicStepsMatchTheGeneralStep) {
   }
 }
 
+TEST(Chebyshev, ClosedFormWeightsFollowTheRecurrence) {
+  // ω_2 = 1 / (1 - ρ²/2), ω_{k+1} = 1 / (1 - ρ² ω_k / 4), towards 2 / (1 + sqrt(1 - ρ²)).
+  for (double rho : {0.3, 0.9, 0.999, 0.99999}) {
+    double omega = 1.0 / (1.0 - 0.5 * rho * rho);
+    EXPECT_NEAR(chebyshevOmega(1, rho), omega, 1e-12) << rho;
+    for (int k = 2; k < 3000; ++k) {
+      omega = 1.0 / (1.0 - 0.25 * rho * rho * omega);
+      ASSERT_NEAR(chebyshevOmega(k, rho), omega, 1e-9 * omega) << rho << " k " << k;
+    }
+    EXPECT_NEAR(chebyshevOmega(100000, rho), 2.0 / (1.0 + std::sqrt(1.0 - rho * rho)), 1e-9);
+    EXPECT_NEAR(chebyshevRate(rho), rho / (1.0 + std::sqrt(1.0 - rho * rho)), 1e-15);
+  }
+  EXPECT_EQ(chebyshevOmega(5, 0.0), 1.0);  // nothing survives a step: plain steps
+}
+
+/// The accumulated c0 of every channel: Σ |a - b| over Σ b, worst channel.
+double relativeL1(const ShGrid& a, const ShGrid& b) {
+  double worst = 0.0;
+  for (int ch = 0; ch < 3; ++ch) {
+    double difference = 0.0, total = 0.0;
+    for (std::size_t i = 0; i < b.planes[std::size_t(ch) * 4].size(); ++i) {
+      difference += std::abs(double(a.planes[std::size_t(ch) * 4][i]) - b.planes[std::size_t(ch) * 4][i]);
+      total += std::abs(double(b.planes[std::size_t(ch) * 4][i]));
+    }
+    worst = std::max(worst, difference / total);
+  }
+  return worst;
+}
+
+TEST(Chebyshev, AutoStepsReachTheConvergedLatticeInFewerSteps) {
+  // --steps auto as the semi-iteration against the plain steps run to convergence (1e-9),
+  // on the balls above (varying D, negative retention, a linear band at the start) and
+  // on a nearly white cube where light needs many steps to cross. The semi-iteration
+  // stops once its estimated remaining light is under autoTolerance (1e-3) of the total,
+  // so it must land within 2e-3 (Σ|Δ| / Σ, worst channel), in fewer steps than the
+  // plain --steps auto (which adds its geometric tail).
+  struct Case {
+    const char* name;
+    Ball ball;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"heterogeneous", ballCase(18, true, false, 3u)});
+  cases.push_back({"heterogeneous with lobes", ballCase(18, true, true, 7u)});
+  cases.push_back({"dense", ballCase(18, false, false, 5u)});
+  Ball cube;
+  cube.material = uniformMaterial(32, glm::vec3(1.0f), glm::vec3(0.998f), 0.0f);
+  cube.injected.resize(cube.material.frame);
+  putLobe(cube.injected, 1, 16, 16, glm::vec3(1, 0, 0), 1.0f);
+  cases.push_back({"white cube", cube});
+  for (const Case& c : cases) {
+    const StepFactors factors = computeStepFactors(c.ball.material, LpvScheme::Calibrated, 1.4);
+    const auto run = [&](bool chebyshev, double tolerance) {
+      LobeRun r;
+      r.field = c.ball.injected;
+      r.accumulated.resize(c.ball.material.frame);
+      PropagationOptions o;
+      o.autoSteps = true;
+      o.chebyshev = chebyshev;
+      o.recordEnergy = true;
+      if (tolerance > 0.0) {
+        o.autoTolerance = tolerance;
+        o.autoTailTolerance = tolerance;
+        o.maxAutoSteps = 100000;
+      }
+      r.result = propagate(c.ball.material, factors, r.field, r.accumulated, o);
+      return r;
+    };
+    const LobeRun converged = run(false, 1e-9), plain = run(false, 0.0), fast = run(true, 0.0);
+    ASSERT_LT(converged.result.stepsRun, 100000) << c.name;
+    const double error = relativeL1(fast.accumulated, converged.accumulated);
+    std::printf("%s: plain auto %d steps (%.2e off the converged lattice), Chebyshev %d steps (%.2e), converged "
+                "after %d\n",
+                c.name, plain.result.stepsRun, relativeL1(plain.accumulated, converged.accumulated),
+                fast.result.stepsRun, error, converged.result.stepsRun);
+    EXPECT_LT(error, 2e-3) << c.name;
+    EXPECT_LT(fast.result.stepsRun, plain.result.stepsRun) << c.name;
+    // Only the first, plain step's energy is recorded; the iterates' sums are not energies.
+    EXPECT_EQ(fast.result.energy.size(), 1u) << c.name;
+    EXPECT_EQ(fast.result.tailScale, glm::dvec3(0.0)) << c.name;
+  }
+}
+
+TEST(Chebyshev, FixedStepsAndTheSeedSchemeKeepThePlainSteps) {
+  // The semi-iteration replaces only --steps auto on isotropic steps: 8 steps move light
+  // 8 cells either way, and the seed scheme's steps are never isotropic.
+  const Ball ball = ballCase(12, true, false, 13u);
+  for (LpvScheme scheme : {LpvScheme::Calibrated, LpvScheme::Seed}) {
+    const StepFactors factors = computeStepFactors(ball.material, scheme, 1.4);
+    for (bool autoSteps : {false, true}) {
+      if (autoSteps && scheme == LpvScheme::Calibrated) continue;
+      const auto run = [&](bool chebyshev) {
+        LobeRun r;
+        r.field = ball.injected;
+        r.accumulated.resize(ball.material.frame);
+        PropagationOptions o;
+        o.steps = 8;
+        o.autoSteps = autoSteps;
+        o.chebyshev = chebyshev;
+        r.result = propagate(ball.material, factors, r.field, r.accumulated, o);
+        return r;
+      };
+      const LobeRun with = run(true), without = run(false);
+      EXPECT_EQ(with.result.stepsRun, without.result.stepsRun);
+      EXPECT_EQ(with.accumulated.planes, without.accumulated.planes) << lpvSchemeName(scheme);
+    }
+  }
+}
+
 TEST(Propagation, SeedStepsNeverTakeTheIsotropicPath) {
   // The seed scheme keeps a linear band (its linear factors are not 0): an isotropic start
   // must still propagate through the general step, which turns it anisotropic at the

@@ -122,6 +122,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     PropagationOptions options;
     options.steps = settings.steps;
     options.autoSteps = settings.autoSteps;
+    options.chebyshev = true;
     report.propagation = propagate(material_, factors_, field, accumulated_, options);
     report.times.propagation = watch.lapMs();
   } else {

@@ -42,6 +42,16 @@
 // stop nor adds a tail; a tail r/(1-r) times this is negligible unless r > 0.9999.
 #define SSLPV_AUTO_STEP_NEGLIGIBLE 1e-6
 
+// --steps auto as a Chebyshev semi-iteration (PropagationOptions::chebyshev): plain steps
+// that estimate the step operator's spectral radius from their power ratio before the
+// iterates start, and the iterates over which the observed shrink of their change is
+// averaged (a running mean of its log with this weight on the newest) before the stop
+// may use it.
+#define SSLPV_CHEBYSHEV_PROBE_STEPS 16
+#define SSLPV_CHEBYSHEV_RATE_WINDOW 8
+// Spectral radius estimates stay below 1 by this much (a ratio of 1 is float noise).
+#define SSLPV_CHEBYSHEV_MAX_RHO (1.0 - 1e-7)
+
 // The calibrated exit law's table (volume/exit_law.h): rows over t = sqrt(1 - a') at
 // t = k / ALBEDO_INTERVALS, columns over the outside cosine mu_o = j / MU_INTERVALS,
 // row-major, (ALBEDO_INTERVALS + 1) x (MU_INTERVALS + 1) floats, bilinear.

@@ -90,10 +90,31 @@ struct PropagationOptions {
   int maxAutoSteps = 10000;
   bool recordEnergy = false;  ///< fill PropagationResult::energy for every step
   /// Steps of an isotropic field under a scheme that keeps it isotropic (the calibrated
-  /// one) as a stencil on c0 alone: the same light up to float rounding, about 4x faster.
-  /// Off only to compare with the general step.
+  /// one) as a stencil on c0 alone: the same light up to float rounding, 5-9x faster on
+  /// the CPU. Off only to compare with the general step.
   bool isotropicFastPath = true;
+  /// --steps auto on isotropic steps (above) as a Chebyshev semi-iteration towards the
+  /// lattice's converged light x = (I - T)^-1 y instead of summing the steps: after the
+  /// first step (whose light is y), SSLPV_CHEBYSHEV_PROBE_STEPS plain steps estimate the
+  /// spectral radius rho from their power ratio, then x_{k+1} = ω_k (T x_k + y - x_{k-1})
+  /// + x_{k-1} (chebyshevOmega) until the light still to come is under autoTolerance.
+  /// 2-12x fewer steps on the shipped scenes, within 0.05 % of the plain steps' image.
+  /// Only the first step's energy is recorded, and no tail is added. Both renderers ask
+  /// for it; the default keeps the plain steps, whose per-step light the tests inspect.
+  /// On the GPU, device-resident runs only (GpuPropagator::runOnDevice, record).
+  bool chebyshev = false;
 };
+
+/// The Chebyshev semi-iteration's weight for iterate k + 1 (k ≥ 1; iterate 1 has weight
+/// 1) when the step operator's eigenvalues lie in [-rho, rho]:
+/// ω = 2 / (1 + tanh(k acosh(1/rho)) sqrt(1 - rho²)), the closed form of the three-term
+/// recurrence ω_{k+1} = 1 / (1 - rho² ω_k / 4). Both backends take it from here.
+double chebyshevOmega(int k, double rho);
+
+/// The factor by which the semi-iteration's error shrinks per step in the limit,
+/// rho / (1 + sqrt(1 - rho²)); its --steps auto rule extrapolates the rest with it (or
+/// with the shrink it observes, where that is slower).
+double chebyshevRate(double rho);
 
 struct PropagationResult {
   int stepsRun = 0;

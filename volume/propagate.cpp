@@ -254,6 +254,56 @@ void gatherSliceIsotropic(int z, const StepFactors& factors, const ShGrid& src, 
   }
 }
 
+/// Power sums of one slice of a Chebyshev iterate, per channel.
+struct ChebyshevSums {
+  glm::dvec3 change{0.0};  ///< Σ |x_{k+1} - x_k| over active cells (c0)
+  glm::dvec3 total{0.0};   ///< Σ x_{k+1}
+};
+
+/// One iterate of the Chebyshev semi-iteration for x = (I - T)^-1 y on the isotropic
+/// stencil of gatherSliceIsotropic (without its clamp: the iterates approach the
+/// converged light from both sides, and T must stay linear for the weights to hold):
+/// x_{k+1} = ω (T x_k + y - x_{k-1}) + x_{k-1}, written over x_{k-1} in `older` (each
+/// cell reads its own old value only; neighbours are read from `current`).
+template <bool kRetain, bool kConduct>
+void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const std::array<std::vector<float>, 3>& current,
+                    std::array<std::vector<float>, 3>& older, const std::array<std::vector<float>, 3>& source,
+                    const glm::vec3& omega, ChebyshevSums& s) {
+  const std::size_t sx = 1, sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
+  for (int y = 1; y < f.dims.y - 1; ++y) {
+    if (!factors.rowActive[std::size_t(z) * f.dims.y + y]) continue;
+    const std::size_t rowStart = f.index(1, y, z);
+    const int row = f.dims.x - 2;
+    for (int ch = 0; ch < 3; ++ch) {
+      const float* __restrict x = current[ch].data();
+      const float* __restrict b = source[ch].data();
+      float* __restrict out = older[ch].data();
+      const float* __restrict dc = factors.dc[ch].data();
+      const unsigned char* __restrict active = factors.active.data();
+      const float* __restrict retain = kRetain ? factors.retention[ch].data() : nullptr;
+      const float* __restrict conduct = kConduct ? factors.conductance[ch].data() : nullptr;
+      const float w = omega[ch];
+      float change = 0.0f, total = 0.0f;
+#pragma omp simd reduction(+ : change, total)
+      for (int k = 0; k < row; ++k) {
+        const std::size_t i = rowStart + k;
+        const auto sent = [&](std::size_t j) { return kConduct ? conduct[j] * x[j] : x[j]; };
+        float g = sent(i - sx) + sent(i + sx) + sent(i - sy) + sent(i + sy) + sent(i - sz) + sent(i + sz);
+        if constexpr (kRetain) g += retain[i] * sent(i);
+        g *= kIsotropicShare;
+        if constexpr (kConduct) g *= conduct[i];
+        const float on = active[i] ? 1.0f : 0.0f;
+        const float next = on * (w * (g * dc[i] + b[i] - out[i]) + out[i]);
+        out[i] = next;
+        change += std::abs(next - x[i]);
+        total += next;
+      }
+      s.change[ch] += double(change);
+      s.total[ch] += double(total);
+    }
+  }
+}
+
 /// Does the field hold any linear band? A field without one stays without one under a
 /// scheme whose linear factors are all 0.
 bool hasLinearBand(const ShGrid& field) {
@@ -326,6 +376,110 @@ void addTail(const ShGrid& lastField, const glm::dvec3& tailScale, ShGrid& accum
       std::vector<float>& to = accumulated.planes[ch * 4 + sh];
       for (std::size_t i = 0; i < to.size(); ++i) to[i] += scale * from[i];
     }
+  }
+}
+
+}  // namespace
+
+double chebyshevOmega(int k, double rho) {
+  if (!(rho > 0.0) || k < 1) return 1.0;
+  return 2.0 / (1.0 + std::tanh(k * std::acosh(1.0 / rho)) * std::sqrt(1.0 - rho * rho));
+}
+
+double chebyshevRate(double rho) { return rho > 0.0 ? rho / (1.0 + std::sqrt(std::max(0.0, 1.0 - rho * rho))) : 0.0; }
+
+namespace {
+
+/// The stop of --steps auto for the semi-iteration, per channel from the last iterate's
+/// change and total: every lit channel's light still to come, estimated as the change
+/// times rate / (1 - rate) (its error shrinks by about `rate` per step), is below
+/// `tolerance` of its total, or the change is float noise. No tail is added: unlike the
+/// plain steps' geometric tail, the estimate is only a bound. lpv_reduce.comp applies
+/// the same rule.
+bool chebyshevConverged(const ChebyshevSums& sums, const glm::dvec3& rate, double tolerance) {
+  for (int ch = 0; ch < 3; ++ch) {
+    const double total = sums.total[ch], change = sums.change[ch];
+    if (!(total > 0.0) || !(change > SSLPV_AUTO_STEP_NEGLIGIBLE * total)) continue;
+    if (!(change * rate[ch] / (1.0 - rate[ch]) < tolerance * total)) return false;
+  }
+  return true;
+}
+
+/// Runs the semi-iteration for x = (I - T)^-1 y, y the light of the first step (in
+/// `field`, which ends holding the last iterate), adding x - y to `accumulated`, which
+/// already holds y. T is similar to a symmetric operator (T = S W (K + R) W / 6: survival,
+/// conductance, neighbours, retention), so its spectrum is real, within [-max s, max s];
+/// with the weights for any rho < 1 the error of each mode λ shrinks as
+/// T_k(λ / rho) / T_k(1 / rho), which goes to 0 for every |λ| < 1: a rho under the true
+/// radius only converges more slowly, so the probe's estimate from below is safe. The
+/// iterates start from the last probe step's light; any start converges.
+void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated, const PropagationOptions& options,
+                  int maxSteps, PropagationResult& result) {
+  const GridFrame& f = field.frame;
+  std::array<std::vector<float>, 3> source, current, older, none;
+  for (int ch = 0; ch < 3; ++ch) {
+    source[ch] = field.planes[std::size_t(ch) * 4];
+    current[ch] = source[ch];
+    older[ch].assign(source[ch].size(), 0.0f);  // x_{-1}: weight 1 cancels it
+    none[ch].assign(source[ch].size(), 0.0f);
+  }
+  const bool retain = !factors.retention[0].empty();
+  const bool conduct = !factors.conductance[0].empty();
+  std::vector<ChebyshevSums> sums(f.dims.z);
+  const auto iterate = [&](const glm::vec3& omega, const std::array<std::vector<float>, 3>& b) {
+    std::fill(sums.begin(), sums.end(), ChebyshevSums{});
+    tbb::parallel_for(tbb::blocked_range<int>(1, f.dims.z - 1), [&](const tbb::blocked_range<int>& zs) {
+      FlushDenormals flush;
+      for (int z = zs.begin(); z < zs.end(); ++z) {
+        if (conduct)
+          chebyshevSlice<true, true>(z, f, factors, current, older, b, omega, sums[z]);
+        else if (retain)
+          chebyshevSlice<true, false>(z, f, factors, current, older, b, omega, sums[z]);
+        else
+          chebyshevSlice<false, false>(z, f, factors, current, older, b, omega, sums[z]);
+      }
+    });
+    std::swap(current, older);
+    ++result.stepsRun;
+    ChebyshevSums total;
+    for (const ChebyshevSums& s : sums) {
+      total.change += s.change;
+      total.total += s.total;
+    }
+    return total;
+  };
+  // Probe: plain steps from y, whose power ratio approaches the spectral radius of the
+  // modes that carry the light from below (an estimate under the radius is safe: the
+  // iteration still converges, more slowly).
+  glm::dvec3 previous(0.0), rho(0.0);
+  for (int ch = 0; ch < 3; ++ch) for (float v : source[ch]) previous[ch] += v;
+  for (int k = 0; k < SSLPV_CHEBYSHEV_PROBE_STEPS && result.stepsRun < maxSteps; ++k) {
+    const ChebyshevSums t = iterate(glm::vec3(1.0f), none);
+    for (int ch = 0; ch < 3; ++ch)
+      rho[ch] = previous[ch] > 0.0 ? std::clamp(t.total[ch] / previous[ch], 0.0, SSLPV_CHEBYSHEV_MAX_RHO) : 0.0;
+    previous = t.total;
+  }
+  const glm::dvec3 rate(chebyshevRate(rho.x), chebyshevRate(rho.y), chebyshevRate(rho.z));
+  // The observed shrink per iterate: a running mean of log(change / last change).
+  glm::dvec3 lastChange(0.0), logShrink(0.0);
+  for (int k = 1; result.stepsRun < maxSteps; ++k) {
+    glm::vec3 omega(1.0f);
+    for (int ch = 0; ch < 3; ++ch) omega[ch] = float(chebyshevOmega(k - 1, rho[ch]));
+    const ChebyshevSums total = iterate(omega, source);
+    glm::dvec3 effective = rate;
+    for (int ch = 0; ch < 3; ++ch) {
+      if (k > 1 && lastChange[ch] > 0.0 && total.change[ch] > 0.0)
+        logShrink[ch] += (std::log(total.change[ch] / lastChange[ch]) - logShrink[ch]) / SSLPV_CHEBYSHEV_RATE_WINDOW;
+      // Where modes above the probe's estimate shrink more slowly than the theory says.
+      effective[ch] = std::max(rate[ch], std::min(std::exp(logShrink[ch]), SSLPV_CHEBYSHEV_MAX_RHO));
+    }
+    lastChange = total.change;
+    if (k > SSLPV_CHEBYSHEV_RATE_WINDOW && chebyshevConverged(total, effective, options.autoTolerance)) break;
+  }
+  for (int ch = 0; ch < 3; ++ch) {
+    float* sum = accumulated.plane(ch, 0);
+    for (std::size_t i = 0; i < current[ch].size(); ++i) sum[i] += current[ch][i] - source[ch][i];
+    field.planes[std::size_t(ch) * 4] = std::move(current[ch]);
   }
 }
 
@@ -423,6 +577,12 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
       result.energy.push_back(
           StepEnergy{total.inGrid, total.emitted - total.gathered, total.absorbed, total.clampRemoved});
     accumulatedPower += total.inGrid;
+    if (options.chebyshev && options.autoSteps && keepsIsotropic) {
+      // The first step has turned the injected light into y, isotropic and accumulated;
+      // the rest of the lattice's light is (I - T)^-1 y - y.
+      runChebyshev(factors, field, accumulated, options, maxSteps, result);
+      break;
+    }
     if (options.autoSteps) {
       const AutoStepDecision decision =
           decideAutoStop(total.inGrid, previousInGrid, accumulatedPower, options.autoTolerance, options.autoTailTolerance);
