@@ -19,6 +19,14 @@ inline constexpr double kBytesPerCellStep = 48 + 32 + 48 + 48;
 /// The calibrated scheme's isotropic steps (gpu_propagation_bench's header): same bytes.
 inline constexpr double kIsotropicFlopsPerCellStep = 3 * (4 + 24 + 2 + 13 + 4);
 
+/// Mean flop per active cell-step of a run of `steps` in the calibrated scheme (the first
+/// step general, the rest isotropic; the semi-iteration's few extra adds not counted) or
+/// the seed's (all general).
+inline double propagationFlopsPerCellStep(bool calibrated, int steps) {
+  if (!calibrated || steps < 2) return kFlopsPerCellStep;
+  return (kFlopsPerCellStep + (steps - 1) * kIsotropicFlopsPerCellStep) / steps;
+}
+
 inline double medianOf(std::vector<double> values) {
   if (values.empty()) return 0.0;
   std::sort(values.begin(), values.end());
