@@ -117,6 +117,41 @@ void expectRunsMatch(const Outcome& gpu, const Outcome& cpu, const std::string& 
   expectGridsMatch(gpu.field, cpu.field, what + " last field");
 }
 
+/// runOnDevice() from the injected light uploaded as injection leaves it, on a propagator
+/// of its own (so that no path can pass on what another left in the buffers).
+Outcome runDeviceResident(const gpu::VulkanDevice& device, const MaterialGrid& material, const StepFactors& factors,
+                          const ShGrid& injected, const PropagationOptions& options,
+                          const gpu::GpuPropagatorOptions& gpuOptions) {
+  gpu::GpuPropagator propagator(device, material.frame, factors, gpuOptions);
+  Outcome run;
+  run.field.resize(material.frame);
+  run.accumulated.resize(material.frame);
+  propagator.uploadField(injected, propagator.sourceField(), true);
+  run.result = propagator.runOnDevice(options);
+  propagator.downloadField(propagator.accumulated(), run.accumulated);
+  propagator.downloadLastField(run.field);
+  return run;
+}
+
+/// The same through record(): one command buffer, no host in the loop, no energy records
+/// (result.stepsRun only).
+Outcome runRecorded(const gpu::VulkanDevice& device, const MaterialGrid& material, const StepFactors& factors,
+                    const ShGrid& injected, const PropagationOptions& options,
+                    const gpu::GpuPropagatorOptions& gpuOptions) {
+  gpu::GpuPropagator propagator(device, material.frame, factors, gpuOptions);
+  propagator.uploadField(injected, propagator.sourceField(), true);
+  gpu::CommandContext commands(device);
+  propagator.record(commands.begin(), options);
+  commands.submitAndWait();
+  Outcome run;
+  run.field.resize(material.frame);
+  run.accumulated.resize(material.frame);
+  run.result.stepsRun = propagator.stepsRun();
+  propagator.downloadField(propagator.accumulated(), run.accumulated);
+  propagator.downloadLastField(run.field);
+  return run;
+}
+
 PropagationOptions stepsWithEnergy(int steps) {
   PropagationOptions options;
   options.steps = steps;
@@ -346,29 +381,12 @@ TEST_F(GpuPropagation, DeviceResidentRunsEqualTheHostRun) {
     host.result = hostPath.run(host.field, host.accumulated, options);
     ASSERT_GT(host.result.stepsRun, 1) << what;
 
-    gpu::GpuPropagator devicePath(device(), c.material.frame, factors, gpuOptions);
-    Outcome onDevice;
-    onDevice.field.resize(c.material.frame);
-    onDevice.accumulated.resize(c.material.frame);
-    devicePath.uploadField(c.injected, devicePath.sourceField(), true);
-    onDevice.result = devicePath.runOnDevice(options);
-    devicePath.downloadField(devicePath.accumulated(), onDevice.accumulated);
-    devicePath.downloadLastField(onDevice.field);
-    expectRunsMatch(onDevice, host, what + " on the device", kDevicePowerTolerance);
-
-    // record(): one command buffer, no host in the loop, no energy records.
-    gpu::GpuPropagator recordPath(device(), c.material.frame, factors, gpuOptions);
-    recordPath.uploadField(c.injected, recordPath.sourceField(), true);
-    gpu::CommandContext commands(device());
-    recordPath.record(commands.begin(), options);
-    commands.submitAndWait();
-    EXPECT_EQ(recordPath.stepsRun(), host.result.stepsRun) << what << " recorded";
-    ShGrid recorded;
-    recorded.resize(c.material.frame);
-    recordPath.downloadField(recordPath.accumulated(), recorded);
-    expectGridsMatch(recorded, host.accumulated, what + " recorded, accumulated");
-    recordPath.downloadLastField(recorded);
-    expectGridsMatch(recorded, host.field, what + " recorded, last field");
+    expectRunsMatch(runDeviceResident(device(), c.material, factors, c.injected, options, gpuOptions), host,
+                    what + " on the device", kDevicePowerTolerance);
+    const Outcome recorded = runRecorded(device(), c.material, factors, c.injected, options, gpuOptions);
+    EXPECT_EQ(recorded.result.stepsRun, host.result.stepsRun) << what << " recorded";
+    expectGridsMatch(recorded.accumulated, host.accumulated, what + " recorded, accumulated");
+    expectGridsMatch(recorded.field, host.field, what + " recorded, last field");
   }
 
   gpu::GpuPropagator propagator(device(), c.material.frame, factors);
@@ -409,26 +427,12 @@ TEST_F(GpuPropagation, ChebyshevAutoStepsOnTheDeviceMatchTheCpu) {
 
     gpu::GpuPropagatorOptions gpuOptions;
     gpuOptions.stepsPerSubmission = 5;
-    gpu::GpuPropagator devicePath(device(), c.material.frame, factors, gpuOptions);
-    Outcome onDevice;
-    onDevice.field.resize(c.material.frame);
-    onDevice.accumulated.resize(c.material.frame);
-    devicePath.uploadField(c.injected, devicePath.sourceField(), true);
-    onDevice.result = devicePath.runOnDevice(options);
-    devicePath.downloadField(devicePath.accumulated(), onDevice.accumulated);
-    devicePath.downloadLastField(onDevice.field);
-    expectRunsMatch(onDevice, cpu, what + " on the device", kDevicePowerTolerance);
-
-    gpu::GpuPropagator recordPath(device(), c.material.frame, factors, gpuOptions);
-    recordPath.uploadField(c.injected, recordPath.sourceField(), true);
-    gpu::CommandContext commands(device());
-    recordPath.record(commands.begin(), options);
-    commands.submitAndWait();
-    EXPECT_EQ(recordPath.stepsRun(), cpu.result.stepsRun) << what << " recorded";
-    ShGrid recorded;
-    recorded.resize(c.material.frame);
-    recordPath.downloadField(recordPath.accumulated(), recorded);
-    expectGridsMatch(recorded, cpu.accumulated, what + " recorded, accumulated");
+    expectRunsMatch(runDeviceResident(device(), c.material, factors, c.injected, options, gpuOptions), cpu,
+                    what + " on the device", kDevicePowerTolerance);
+    const Outcome recorded = runRecorded(device(), c.material, factors, c.injected, options, gpuOptions);
+    EXPECT_EQ(recorded.result.stepsRun, cpu.result.stepsRun) << what << " recorded";
+    expectGridsMatch(recorded.accumulated, cpu.accumulated, what + " recorded, accumulated");
+    expectGridsMatch(recorded.field, cpu.field, what + " recorded, last iterate");
 
     // From host grids the propagator keeps the plain steps (run() keeps no y).
     const Outcome host = runGpu(device(), c.material, c.injected, options, {}, LpvScheme::Calibrated);
