@@ -69,6 +69,8 @@ void main() {
       control.rhoG = rho.g;
       control.rhoB = rho.b;
       control.omegaR = control.omegaG = control.omegaB = 1.0;  // the first iterate's
+      // No light left before this step: converged (runChebyshev's `dark`).
+      if (!(previous.r > 0.0) && !(previous.g > 0.0) && !(previous.b > 0.0)) control.stopped = 1;
       return;
     }
     const int k = control.iterates + 1;

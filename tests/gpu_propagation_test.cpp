@@ -438,6 +438,15 @@ TEST_F(GpuPropagation, ChebyshevAutoStepsOnTheDeviceMatchTheCpu) {
     const Outcome host = runGpu(device(), c.material, c.injected, options, {}, LpvScheme::Calibrated);
     EXPECT_EQ(host.result.stepsRun, plainSteps) << what << " from the host";
   }
+  // A dark grid stops after one probe step on both.
+  RandomCase dark = shapedCase(glm::ivec3(12, 11, 13), false, rng);
+  for (std::vector<float>& plane : dark.injected.planes) std::fill(plane.begin(), plane.end(), 0.0f);
+  PropagationOptions options;
+  options.autoSteps = true;
+  options.chebyshev = true;
+  const StepFactors darkFactors = computeStepFactors(dark.material, LpvScheme::Calibrated, 1.4);
+  EXPECT_EQ(runDeviceResident(device(), dark.material, darkFactors, dark.injected, options, {}).result.stepsRun,
+            runCpu(dark.material, dark.injected, options, LpvScheme::Calibrated).result.stepsRun);
   reportWorst("ChebyshevAutoStepsOnTheDeviceMatchTheCpu");
 }
 

@@ -490,6 +490,22 @@ TEST(Chebyshev, AutoStepsReachTheConvergedLatticeInFewerSteps) {
   }
 }
 
+TEST(Chebyshev, ADarkGridStopsAfterOneProbeStep) {
+  // No injected light: the first step and one probe step, whose predecessor held
+  // nothing, and the accumulated light stays zero.
+  const Ball ball = ballCase(12, true, false, 17u);
+  const StepFactors factors = computeStepFactors(ball.material, LpvScheme::Calibrated, 1.4);
+  ShGrid field, accumulated;
+  field.resize(ball.material.frame);
+  accumulated.resize(ball.material.frame);
+  PropagationOptions options;
+  options.autoSteps = true;
+  options.chebyshev = true;
+  EXPECT_EQ(propagate(ball.material, factors, field, accumulated, options).stepsRun, 2);
+  for (const std::vector<float>& plane : accumulated.planes)
+    EXPECT_TRUE(std::all_of(plane.begin(), plane.end(), [](float v) { return v == 0.0f; }));
+}
+
 TEST(Chebyshev, FixedStepsAndTheSeedSchemeKeepThePlainSteps) {
   // The semi-iteration replaces only --steps auto on isotropic steps: 8 steps move light
   // 8 cells either way, and the seed scheme's steps are never isotropic.

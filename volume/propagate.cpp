@@ -453,8 +453,12 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   // iteration still converges, more slowly).
   glm::dvec3 previous(0.0), rho(0.0);
   for (int ch = 0; ch < 3; ++ch) for (float v : source[ch]) previous[ch] += v;
-  for (int k = 0; k < SSLPV_CHEBYSHEV_PROBE_STEPS && result.stepsRun < maxSteps; ++k) {
+  // Where no light is left (a dark scene, or one absorbed within the probe) the light is
+  // already converged: stop after the probe step that finds it so, as the GPU does.
+  bool dark = false;
+  for (int k = 0; k < SSLPV_CHEBYSHEV_PROBE_STEPS && result.stepsRun < maxSteps && !dark; ++k) {
     const ChebyshevSums t = iterate(glm::vec3(1.0f), none);
+    dark = !(previous.x > 0.0) && !(previous.y > 0.0) && !(previous.z > 0.0);
     for (int ch = 0; ch < 3; ++ch)
       rho[ch] = previous[ch] > 0.0 ? std::clamp(t.total[ch] / previous[ch], 0.0, SSLPV_CHEBYSHEV_MAX_RHO) : 0.0;
     previous = t.total;
@@ -462,7 +466,7 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   const glm::dvec3 rate(chebyshevRate(rho.x), chebyshevRate(rho.y), chebyshevRate(rho.z));
   // The observed shrink per iterate: a running mean of log(change / last change).
   glm::dvec3 lastChange(0.0), logShrink(0.0);
-  for (int k = 1; result.stepsRun < maxSteps; ++k) {
+  for (int k = 1; result.stepsRun < maxSteps && !dark; ++k) {
     glm::vec3 omega(1.0f);
     for (int ch = 0; ch < 3; ++ch) omega[ch] = float(chebyshevOmega(k - 1, rho[ch]));
     const ChebyshevSums total = iterate(omega, source);
