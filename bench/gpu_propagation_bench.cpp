@@ -25,14 +25,16 @@
 //   accumulate (2 adds x 12 floats, every other step)                           =  12
 //   total                                                                        726 flop
 // (the CPU's structure, normalize then evaluate the faces again per neighbour, needs
-// 1024). The calibrated scheme keeps every cell isotropic, so its steps after the first
-// run as a stencil on c0 (the "isotropic" rows; "general" rows force the kernel above on
-// the same factors, for comparison): per channel, the cell's power and its lobe (4), the
-// 6 lobes added as vec4 (24), retention (2), step factors and power sums (13),
-// accumulate (4) = 141 flop on the same 176 B, so those rows are bandwidth-bound. Bytes per active cell and step, compulsory memory traffic (halos assumed
+// 1024). Bytes per active cell and step, compulsory memory traffic (halos assumed
 // cached): source 48 + factors 32 + destination 48 + accumulated (48 read + 48 written
 // every other step) 48 = 176 B, so 4.1 flop/B. Attainable = min(peak FMA, 4.1 x
 // bandwidth); "roof %" is the kernel's achieved GFLOP/s over that.
+// The calibrated scheme keeps every cell isotropic, so its steps after the first run as
+// a stencil on c0 ("calibrated/iso" rows; "calibrated/gen" rows force the kernel above
+// on the same factors, for comparison): per channel, the cell's power and its lobe (4),
+// the 6 lobes added as vec4 (24), retention (2), step factors and power sums (13),
+// accumulate (4) = 141 flop on the same 176 B, so those rows are bandwidth-bound (their
+// first step is general: bench::propagationFlopsPerCellStep averages the two).
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -265,9 +267,9 @@ int main(int argc, char** argv) {
                 "shape", "scheme/step", "steps", "active", "covered", "items", "gpu ms", "wall ms", "proc ms", "Mcell/s", "GFLOP/s", "GB/s",
                 "peak GF", "GB/s", "roof%", "cpu ms", "Mcell/s", "cpu/gpu");
     for (int n : bench.sizes)
-      for (Shape shape : bench.shapes)
+      for (Shape shape : bench.shapes) {
+        const MaterialGrid material = makeMaterial(n, shape);
         for (LpvScheme scheme : bench.schemes) {
-          const MaterialGrid material = makeMaterial(n, shape);
           const StepFactors factors = computeStepFactors(material, scheme, 1.4);
           const ShGrid injected = litField(material, factors);
           // The calibrated scheme's isotropic steps, and its factors through the general step.
@@ -277,8 +279,6 @@ int main(int argc, char** argv) {
             gpuOptions.isotropicSteps = isotropic;
             gpu::GpuPropagator propagator(device, material.frame, factors, gpuOptions);
             const double active = double(propagator.activeCells());
-            const double flops = isotropic ? bench::kIsotropicFlopsPerCellStep : kFlopsPerCellStep;
-            const double cellIntensity = flops / kBytesPerCellStep;
             const std::string variant = lpvSchemeName(scheme) + (isotropicScheme ? isotropic ? "/iso" : "/gen" : "");
             for (int steps : bench.steps) {
               PropagationOptions options;
@@ -286,8 +286,9 @@ int main(int argc, char** argv) {
               options.autoSteps = steps == 0;
               options.isotropicFastPath = isotropic;
               const Peaks peaks = probe.measure(3);
-              const double roof = std::min(peaks.fmaGflops, cellIntensity * peaks.bandwidth());
               const GpuRun gpuRun = benchGpu(propagator, injected, options, bench.repeats);
+              const double flops = bench::propagationFlopsPerCellStep(isotropic, gpuRun.steps);
+              const double roof = std::min(peaks.fmaGflops, flops / kBytesPerCellStep * peaks.bandwidth());
               const double cellRate = active / (gpuRun.kernelMs * 1e-3);  // active cells per second
               const double gflops = cellRate * flops * 1e-9;
               const double cpuMs = bench.cpu ? benchCpu(material, factors, injected, options, bench.repeats) : 0.0;
@@ -303,6 +304,7 @@ int main(int argc, char** argv) {
             }
           }
         }
+      }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gpu_propagation_bench: %s\n", e.what());
     return 1;

@@ -279,14 +279,6 @@ void GpuPropagator::setFactors(const StepFactors& factors) {
   }
   active_ = factors.active;
   isotropicSteps_ = options_.isotropicSteps && keepsCellsIsotropic(factors);
-  if (isotropicSteps_ && isotropicPipelines_[0].pipeline() == VK_NULL_HANDLE) {
-    const auto rows = std::uint32_t(options_.tileRows);
-    for (std::uint32_t variant = 0; variant < 2; ++variant)
-      isotropicPipelines_[variant] = ComputePipeline(device_, spirv::lpv_propagate_comp(), setLayout_.get(),
-                                                     sizeof(LpvStepPush), {rows, variant, 1u, 0u});
-    chebyshevPipeline_ = ComputePipeline(device_, spirv::lpv_propagate_comp(), setLayout_.get(), sizeof(LpvStepPush),
-                                         {rows, 0u, 1u, 1u});
-  }
   freshGain_ = factors.freshGain;
   buildItems(factors);
 }
@@ -381,10 +373,6 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
     // starts the accumulated grid with both, then even steps add.
     if (mode == Mode::Host) push.accumulate = step % 2 == 1 ? 1 : 0;
     if (mode == Mode::Device) push.accumulate = step == 0 ? 2 : step % 2 == 0 ? 1 : 0;
-    // Step 0 reads the injected light, which may hold a linear band; after it, factors
-    // that keep cells isotropic have left none.
-    const ComputePipeline* pipelines = isotropicSteps_ && step > 0 ? isotropicPipelines_ : propagatePipelines_;
-    const ComputePipeline* pipeline = &pipelines[push.accumulate != 0];
     if (chebyshev) {
       // Step 0 leaves its light alone in the accumulated grid (y) and makes no stop
       // decision; then the probe steps and the iterates, which accumulate nothing
@@ -392,9 +380,13 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
       push.autoSteps = step == 0 ? 0 : 1;
       push.chebyshev = step == 0 ? 0 : step <= SSLPV_CHEBYSHEV_PROBE_STEPS ? 1 : 2;
       push.accumulate = step == 0 ? 3 : 0;
-      pipeline = step == 0 ? &propagatePipelines_[1] : &chebyshevPipeline_;
     }
-    pipeline->bind(cmd, sets_[step % 2], &push, sizeof(push));
+    // Step 0 reads the injected light, which may hold a linear band; after it, factors
+    // that keep cells isotropic have left none.
+    const StepKernel kernel = step == 0 || !isotropicSteps_ ? StepKernel::General
+                              : chebyshev                   ? StepKernel::Chebyshev
+                                                            : StepKernel::Isotropic;
+    stepPipeline(kernel, push.accumulate != 0).bind(cmd, sets_[step % 2], &push, sizeof(push));
     if (groups > 0) vkCmdDispatch(cmd, groups, 1, 1);
     computeToComputeBarrier(cmd);
     if (timestamps) timestamps_.write(cmd, 1 + 2 * std::uint32_t(s));
@@ -403,6 +395,19 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
     computeToComputeBarrier(cmd);
     if (timestamps) timestamps_.write(cmd, 2 + 2 * std::uint32_t(s));
   }
+}
+
+const ComputePipeline& GpuPropagator::stepPipeline(StepKernel kernel, bool accumulate) {
+  if (kernel == StepKernel::General) return propagatePipelines_[accumulate];
+  // The Chebyshev iterates never accumulate (their accumulated grid holds y).
+  ComputePipeline& pipeline =
+      kernel == StepKernel::Chebyshev ? chebyshevPipeline_ : isotropicPipelines_[accumulate];
+  if (pipeline.pipeline() == VK_NULL_HANDLE) {
+    const std::uint32_t chebyshev = kernel == StepKernel::Chebyshev ? 1u : 0u;
+    pipeline = ComputePipeline(device_, spirv::lpv_propagate_comp(), setLayout_.get(), sizeof(LpvStepPush),
+                               {std::uint32_t(options_.tileRows), accumulate && !chebyshev ? 1u : 0u, 1u, chebyshev});
+  }
+  return pipeline;
 }
 
 bool GpuPropagator::chebyshevRun(Mode mode, const PropagationOptions& options) const {

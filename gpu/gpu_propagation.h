@@ -130,6 +130,12 @@ class GpuPropagator {
   /// Does this run take the Chebyshev iterates (device-resident auto steps on factors
   /// that keep cells isotropic, PropagationOptions::chebyshev)?
   bool chebyshevRun(Mode mode, const PropagationOptions& options) const;
+  /// The variants of lpv_propagate.comp: the general step, the isotropic stencil, the
+  /// Chebyshev iterate (its specialization constants ISOTROPIC and CHEBYSHEV).
+  enum class StepKernel { General, Isotropic, Chebyshev };
+  /// The pipeline of a step; the isotropic and Chebyshev ones are built on first use, so
+  /// a propagator compiles only the kernels its runs take (each is a JIT on lavapipe).
+  const ComputePipeline& stepPipeline(StepKernel kernel, bool accumulate);
   void recordFinish(VkCommandBuffer cmd, Mode mode, int stepLimit, const PropagationOptions& options);
   void prepareDeviceRun(VkCommandBuffer cmd);
   PropagationResult execute(Mode mode, const PropagationOptions& options);
@@ -151,9 +157,9 @@ class GpuPropagator {
   VkDescriptorSet sets_[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};  ///< set k reads tiled_[k]
   ComputePipeline propagatePipelines_[2];   ///< without and with accumulation
   /// The same for the steps after the first where the factors keep cells isotropic
-  /// (keepsCellsIsotropic), built on first need.
+  /// (keepsCellsIsotropic), and the Chebyshev iterates; built by stepPipeline on first use.
   ComputePipeline isotropicPipelines_[2];
-  ComputePipeline chebyshevPipeline_;  ///< the Chebyshev iterates, built with the above
+  ComputePipeline chebyshevPipeline_;
   bool isotropicSteps_ = false;
   ComputePipeline finishPipelines_[2];      ///< into tiled_ / linear accumulated light
   ComputePipeline reducePipeline_, importPipeline_;

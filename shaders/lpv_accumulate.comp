@@ -38,14 +38,16 @@ void main() {
           // it is missing (always the same field for a given accumulation parity), so
           // otherwise the last step wrote the set's other field. Ring cells hold no light
           // in either grid.
-          const vec4 lastField = addLast ? texelFetch(sourceField, 3 * i + ch) : texelFetch(otherField, 3 * i + ch);
-          vec4 total = texelFetch(accumulatedIn, 3 * i + ch) + lastScale[ch] * lastField;
+          vec4 total;
           if (push.chebyshev != 0) {
             // The last iterate (written by step stepsRun - 1 into the set's source field
             // when stepsRun is even) plus the injected light times its fresh gain.
             const vec4 iterate = stepsRun % 2 == 0 ? texelFetch(sourceField, 3 * i + ch) : texelFetch(otherField, 3 * i + ch);
             const float gain = texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 3)[ch];
             total = iterate + gain * texelFetch(injectedField, 3 * linearIndex(x, y, z) + ch);
+          } else {
+            const vec4 lastField = addLast ? texelFetch(sourceField, 3 * i + ch) : texelFetch(otherField, 3 * i + ch);
+            total = texelFetch(accumulatedIn, 3 * i + ch) + lastScale[ch] * lastField;
           }
           if (OUTPUT == 1) accumulatedOut[3 * linearIndex(x, y, z) + ch] = total;
           else accumulated[3 * i + ch] = total;

@@ -345,6 +345,15 @@ Ball ballCase(int dims, bool heterogeneous, bool lobes, unsigned seed) {
   return b;
 }
 
+/// Propagates the ball's injected light with `options`.
+LobeRun propagateBall(const Ball& ball, const StepFactors& factors, const PropagationOptions& options) {
+  LobeRun r;
+  r.field = ball.injected;
+  r.accumulated.resize(ball.material.frame);
+  r.result = propagate(ball.material, factors, r.field, r.accumulated, options);
+  return r;
+}
+
 TEST(Propagation, CalibratedIsotropicStepsMatchTheGeneralStep) {
   // The calibrated scheme's fast path (a c0 stencil) against the general SH step, with
   // and without a linear band in the starting field (then the first step is general),
@@ -371,13 +380,9 @@ TEST(Propagation, CalibratedIsotropicStepsMatchTheGeneralStep) {
       options.autoSteps = autoSteps;
       options.recordEnergy = true;
       const auto run = [&](bool fast) {
-        LobeRun r;
-        r.field = ball.injected;
-        r.accumulated.resize(ball.material.frame);
         PropagationOptions o = options;
         o.isotropicFastPath = fast;
-        r.result = propagate(ball.material, factors, r.field, r.accumulated, o);
-        return r;
+        return propagateBall(ball, factors, o);
       };
       const LobeRun fast = run(true), general = run(false);
       const std::string name = std::string(c.name) + ", " + (autoSteps ? "auto" : "150") + " steps";
@@ -460,9 +465,6 @@ TEST(Chebyshev, AutoStepsReachTheConvergedLatticeInFewerSteps) {
   for (const Case& c : cases) {
     const StepFactors factors = computeStepFactors(c.ball.material, LpvScheme::Calibrated, 1.4);
     const auto run = [&](bool chebyshev, double tolerance) {
-      LobeRun r;
-      r.field = c.ball.injected;
-      r.accumulated.resize(c.ball.material.frame);
       PropagationOptions o;
       o.autoSteps = true;
       o.chebyshev = chebyshev;
@@ -472,8 +474,7 @@ TEST(Chebyshev, AutoStepsReachTheConvergedLatticeInFewerSteps) {
         o.autoTailTolerance = tolerance;
         o.maxAutoSteps = 100000;
       }
-      r.result = propagate(c.ball.material, factors, r.field, r.accumulated, o);
-      return r;
+      return propagateBall(c.ball, factors, o);
     };
     const LobeRun converged = run(false, 1e-9), plain = run(false, 0.0), fast = run(true, 0.0);
     ASSERT_LT(converged.result.stepsRun, 100000) << c.name;
@@ -515,15 +516,11 @@ TEST(Chebyshev, FixedStepsAndTheSeedSchemeKeepThePlainSteps) {
     for (bool autoSteps : {false, true}) {
       if (autoSteps && scheme == LpvScheme::Calibrated) continue;
       const auto run = [&](bool chebyshev) {
-        LobeRun r;
-        r.field = ball.injected;
-        r.accumulated.resize(ball.material.frame);
         PropagationOptions o;
         o.steps = 8;
         o.autoSteps = autoSteps;
         o.chebyshev = chebyshev;
-        r.result = propagate(ball.material, factors, r.field, r.accumulated, o);
-        return r;
+        return propagateBall(ball, factors, o);
       };
       const LobeRun with = run(true), without = run(false);
       EXPECT_EQ(with.result.stepsRun, without.result.stepsRun);
@@ -539,14 +536,10 @@ TEST(Propagation, SeedStepsNeverTakeTheIsotropicPath) {
   const Ball ball = ballCase(12, true, false, 11u);
   const StepFactors factors = computeStepFactors(ball.material, LpvScheme::Seed, 1.4);
   const auto run = [&](bool fast) {
-    LobeRun r;
-    r.field = ball.injected;
-    r.accumulated.resize(ball.material.frame);
     PropagationOptions o;
     o.steps = 12;
     o.isotropicFastPath = fast;
-    r.result = propagate(ball.material, factors, r.field, r.accumulated, o);
-    return r;
+    return propagateBall(ball, factors, o);
   };
   const LobeRun fast = run(true), general = run(false);
   EXPECT_EQ(fast.accumulated.planes, general.accumulated.planes);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <limits>
 #include <cmath>
+#include <type_traits>
 
 #include "volume/lpv_stages.h"
 #include "volume/sh.h"
@@ -200,6 +201,38 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
 /// lpv_transfer.glsl uses the same constant.
 constexpr float kIsotropicShare = float(SSLPV_ISOTROPIC_NEIGHBOUR_SHARE);
 
+/// What cell i gathers under the isotropic steps, before its survival: the share of the
+/// six neighbours' c0 (and, with retention, ρ_i of its own) times the faces'
+/// conductances, w_i (Σ_j w_j c_j + ρ_i w_i c_i) / 6. kClamp: a cell driven below zero
+/// sends nothing (the plain steps, as the clamp's scale 0 makes it in normalizeEmission);
+/// without it the operator is linear (the Chebyshev iterates).
+template <bool kRetain, bool kConduct, bool kClamp>
+inline float isotropicGather(const float* __restrict c0, const float* __restrict retain,
+                             const float* __restrict conduct, std::size_t i, std::size_t sy, std::size_t sz) {
+  const auto sent = [&](std::size_t j) {
+    const float light = kClamp ? std::max(0.0f, c0[j]) : c0[j];
+    return kConduct ? conduct[j] * light : light;
+  };
+  float g = sent(i - 1) + sent(i + 1) + sent(i - sy) + sent(i + sy) + sent(i - sz) + sent(i + sz);
+  if constexpr (kRetain) g += retain[i] * sent(i);
+  g *= kIsotropicShare;
+  if constexpr (kConduct) g *= conduct[i];
+  return g;
+}
+
+/// Calls body(std::bool_constant<kRetain>, std::bool_constant<kConduct>) for the factors'
+/// boundary and diffusivity variant, so that each kernel's loop carries no test for them
+/// (the seed scheme's neither; a varying D implies the retention array).
+template <typename Body>
+void withBoundaryVariant(const StepFactors& factors, Body&& body) {
+  if (!factors.conductance[0].empty())
+    body(std::true_type{}, std::true_type{});
+  else if (!factors.retention[0].empty())
+    body(std::true_type{}, std::false_type{});
+  else
+    body(std::false_type{}, std::false_type{});
+}
+
 /// gatherSlice for a field without linear band, in a scheme whose steps give it none
 /// (the calibrated one: linear factors 0, isotropic injection). Every lobe is then the
 /// same in all six directions and the clamped face fluxes are exact, so a step reduces to
@@ -212,7 +245,7 @@ template <bool kRetain, bool kConduct>
 void gatherSliceIsotropic(int z, const StepFactors& factors, const ShGrid& src, ShGrid& dst, ShGrid& accumulated,
                           SliceSums& s) {
   const GridFrame& f = src.frame;
-  const std::size_t sx = 1, sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
+  const std::size_t sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
   for (int y = 1; y < f.dims.y - 1; ++y) {
     if (!factors.rowActive[std::size_t(z) * f.dims.y + y]) continue;
     const std::size_t rowStart = f.index(1, y, z);
@@ -229,14 +262,7 @@ void gatherSliceIsotropic(int z, const StepFactors& factors, const ShGrid& src, 
 #pragma omp simd reduction(+ : emitted, gathered, absorbed, kept)
       for (int x = 0; x < row; ++x) {
         const std::size_t i = rowStart + x;
-        const auto sent = [&](std::size_t j) {
-          const float light = std::max(0.0f, c0[j]);
-          return kConduct ? conduct[j] * light : light;
-        };
-        float g = sent(i - sx) + sent(i + sx) + sent(i - sy) + sent(i + sy) + sent(i - sz) + sent(i + sz);
-        if constexpr (kRetain) g += retain[i] * sent(i);
-        g *= kIsotropicShare;
-        if constexpr (kConduct) g *= conduct[i];
+        const float g = isotropicGather<kRetain, kConduct, true>(c0, retain, conduct, i, sy, sz);
         const float on = active[i] ? 1.0f : 0.0f;
         const float v0 = on * g * dc[i];
         out[i] = v0;
@@ -263,13 +289,16 @@ struct ChebyshevSums {
 /// One iterate of the Chebyshev semi-iteration for x = (I - T)^-1 y on the isotropic
 /// stencil of gatherSliceIsotropic (without its clamp: the iterates approach the
 /// converged light from both sides, and T must stay linear for the weights to hold):
-/// x_{k+1} = ω (T x_k + y - x_{k-1}) + x_{k-1}, written over x_{k-1} in `older` (each
-/// cell reads its own old value only; neighbours are read from `current`).
+/// x_{k+1} = ω (T x_k + sourceWeight · y - x_{k-1}) + x_{k-1}, written over x_{k-1} in
+/// `older` (each cell reads its own old value only; neighbours are read from `current`).
+/// A probe step is ω = 1 with sourceWeight 0, as lpv_propagate.comp's.
+using ChannelPlanes = std::array<std::vector<float>, 3>;  ///< one c0 plane per channel
+
 template <bool kRetain, bool kConduct>
-void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const std::array<std::vector<float>, 3>& current,
-                    std::array<std::vector<float>, 3>& older, const std::array<std::vector<float>, 3>& source,
-                    const glm::vec3& omega, ChebyshevSums& s) {
-  const std::size_t sx = 1, sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
+void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const ChannelPlanes& current,
+                    ChannelPlanes& older, const ChannelPlanes& source, const glm::vec3& omega, float sourceWeight,
+                    ChebyshevSums& s) {
+  const std::size_t sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
   for (int y = 1; y < f.dims.y - 1; ++y) {
     if (!factors.rowActive[std::size_t(z) * f.dims.y + y]) continue;
     const std::size_t rowStart = f.index(1, y, z);
@@ -287,13 +316,9 @@ void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const
 #pragma omp simd reduction(+ : change, total)
       for (int k = 0; k < row; ++k) {
         const std::size_t i = rowStart + k;
-        const auto sent = [&](std::size_t j) { return kConduct ? conduct[j] * x[j] : x[j]; };
-        float g = sent(i - sx) + sent(i + sx) + sent(i - sy) + sent(i + sy) + sent(i - sz) + sent(i + sz);
-        if constexpr (kRetain) g += retain[i] * sent(i);
-        g *= kIsotropicShare;
-        if constexpr (kConduct) g *= conduct[i];
+        const float g = isotropicGather<kRetain, kConduct, false>(x, retain, conduct, i, sy, sz);
         const float on = active[i] ? 1.0f : 0.0f;
-        const float next = on * (w * (g * dc[i] + b[i] - out[i]) + out[i]);
+        const float next = on * (w * (g * dc[i] + sourceWeight * b[i] - out[i]) + out[i]);
         out[i] = next;
         change += std::abs(next - x[i]);
         total += next;
@@ -416,28 +441,22 @@ bool chebyshevConverged(const ChebyshevSums& sums, const glm::dvec3& rate, doubl
 void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated, const PropagationOptions& options,
                   int maxSteps, PropagationResult& result) {
   const GridFrame& f = field.frame;
-  std::array<std::vector<float>, 3> source, current, older, none;
+  ChannelPlanes source, current, older;
   for (int ch = 0; ch < 3; ++ch) {
     source[ch] = field.planes[std::size_t(ch) * 4];
     current[ch] = source[ch];
     older[ch].assign(source[ch].size(), 0.0f);  // x_{-1}: weight 1 cancels it
-    none[ch].assign(source[ch].size(), 0.0f);
   }
-  const bool retain = !factors.retention[0].empty();
-  const bool conduct = !factors.conductance[0].empty();
   std::vector<ChebyshevSums> sums(f.dims.z);
-  const auto iterate = [&](const glm::vec3& omega, const std::array<std::vector<float>, 3>& b) {
+  const auto iterate = [&](const glm::vec3& omega, float sourceWeight) {
     std::fill(sums.begin(), sums.end(), ChebyshevSums{});
     tbb::parallel_for(tbb::blocked_range<int>(1, f.dims.z - 1), [&](const tbb::blocked_range<int>& zs) {
       FlushDenormals flush;
-      for (int z = zs.begin(); z < zs.end(); ++z) {
-        if (conduct)
-          chebyshevSlice<true, true>(z, f, factors, current, older, b, omega, sums[z]);
-        else if (retain)
-          chebyshevSlice<true, false>(z, f, factors, current, older, b, omega, sums[z]);
-        else
-          chebyshevSlice<false, false>(z, f, factors, current, older, b, omega, sums[z]);
-      }
+      withBoundaryVariant(factors, [&](auto retain, auto conduct) {
+        constexpr bool kRetain = decltype(retain)::value, kConduct = decltype(conduct)::value;
+        for (int z = zs.begin(); z < zs.end(); ++z)
+          chebyshevSlice<kRetain, kConduct>(z, f, factors, current, older, source, omega, sourceWeight, sums[z]);
+      });
     });
     std::swap(current, older);
     ++result.stepsRun;
@@ -457,7 +476,7 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   // already converged: stop after the probe step that finds it so, as the GPU does.
   bool dark = false;
   for (int k = 0; k < SSLPV_CHEBYSHEV_PROBE_STEPS && result.stepsRun < maxSteps && !dark; ++k) {
-    const ChebyshevSums t = iterate(glm::vec3(1.0f), none);
+    const ChebyshevSums t = iterate(glm::vec3(1.0f), 0.0f);
     dark = !(previous.x > 0.0) && !(previous.y > 0.0) && !(previous.z > 0.0);
     for (int ch = 0; ch < 3; ++ch)
       rho[ch] = previous[ch] > 0.0 ? std::clamp(t.total[ch] / previous[ch], 0.0, SSLPV_CHEBYSHEV_MAX_RHO) : 0.0;
@@ -469,7 +488,7 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   for (int k = 1; result.stepsRun < maxSteps && !dark; ++k) {
     glm::vec3 omega(1.0f);
     for (int ch = 0; ch < 3; ++ch) omega[ch] = float(chebyshevOmega(k - 1, rho[ch]));
-    const ChebyshevSums total = iterate(omega, source);
+    const ChebyshevSums total = iterate(omega, 1.0f);
     glm::dvec3 effective = rate;
     for (int ch = 0; ch < 3; ++ch) {
       if (k > 1 && lastChange[ch] > 0.0 && total.change[ch] > 0.0)
@@ -531,8 +550,6 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
   ShGrid next;
   next.resize(f);
   std::vector<SliceSums> sums(f.dims.z);
-  const bool retain = !factors.retention[0].empty();
-  const bool conduct = !factors.conductance[0].empty();
   // After one full step a scheme with zero linear factors leaves no linear band, so
   // every later step (and the first, when the injection was isotropic) is isotropic.
   const bool keepsIsotropic = options.isotropicFastPath && keepsCellsIsotropic(factors);
@@ -542,22 +559,15 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
     if (!isotropic) normalizeEmission(factors, field, sums);
     tbb::parallel_for(tbb::blocked_range<int>(1, f.dims.z - 1), [&](const tbb::blocked_range<int>& zs) {
       FlushDenormals flush;
-      for (int z = zs.begin(); z < zs.end(); ++z) {
-        if (isotropic) {
-          if (conduct)
-            gatherSliceIsotropic<true, true>(z, factors, field, next, accumulated, sums[z]);
-          else if (retain)
-            gatherSliceIsotropic<true, false>(z, factors, field, next, accumulated, sums[z]);
+      withBoundaryVariant(factors, [&](auto retain, auto conduct) {
+        constexpr bool kRetain = decltype(retain)::value, kConduct = decltype(conduct)::value;
+        for (int z = zs.begin(); z < zs.end(); ++z) {
+          if (isotropic)
+            gatherSliceIsotropic<kRetain, kConduct>(z, factors, field, next, accumulated, sums[z]);
           else
-            gatherSliceIsotropic<false, false>(z, factors, field, next, accumulated, sums[z]);
-        } else if (conduct) {
-          gatherSlice<true, true>(z, factors, field, next, accumulated, sums[z]);
-        } else if (retain) {
-          gatherSlice<true, false>(z, factors, field, next, accumulated, sums[z]);
-        } else {
-          gatherSlice<false, false>(z, factors, field, next, accumulated, sums[z]);
+            gatherSlice<kRetain, kConduct>(z, factors, field, next, accumulated, sums[z]);
         }
-      }
+      });
     });
     if (!isotropic && keepsIsotropic) {
       // The full step wrote zero linear planes into `next`; the isotropic steps leave
