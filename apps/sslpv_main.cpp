@@ -91,6 +91,7 @@ struct ReferenceArgs {
   int spp = 0;
   std::uint64_t seed = 0;
   int threads = 0;
+  int maxScatter = 0;
 };
 
 int runReference(const ReferenceArgs& args) {
@@ -103,6 +104,8 @@ int runReference(const ReferenceArgs& args) {
     throw InputError("--spp: must be a whole number from 1 to 1000000, got " + std::to_string(args.spp));
   if (args.threads < 0 || args.threads > 4096)
     throw InputError("--threads: must be between 0 (all cores) and 4096, got " + std::to_string(args.threads));
+  if (args.maxScatter < 0)
+    throw InputError("--max-scatter: must be 0 (unlimited) or more, got " + std::to_string(args.maxScatter));
   std::filesystem::path errorFile(args.output);
   errorFile.replace_extension(".stderr" + std::filesystem::path(args.output).extension().string());
   requireWritableOutput(args.output);
@@ -114,6 +117,7 @@ int runReference(const ReferenceArgs& args) {
   options.spp = args.spp;
   options.seed = args.seed;
   options.threads = args.threads;
+  options.maxScatterEvents = args.maxScatter;
   const auto start = std::chrono::steady_clock::now();
   int lastPercent = -1;
   options.progress = [&](std::size_t done, std::size_t total) {
@@ -165,6 +169,8 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--spp", reference.spp, "Samples per pixel")->required();
   referenceCmd->add_option("--seed", reference.seed, "Random seed (same seed, same image)");
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
+  referenceCmd->add_option("--max-scatter", reference.maxScatter,
+                           "End paths after this many scattering events (0: unlimited; 1: single scattering only)");
 
   // Subcommands from apps/cmd_*.cpp (each: Args struct, add<Name>Command, run<Name>).
   sslpv::EditArgs edit;

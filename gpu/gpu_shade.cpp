@@ -14,7 +14,7 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 9;  // see the bindings of shaders/shade.{vert,comp}
+constexpr std::uint32_t kBindings = 12;  // see the bindings of shaders/shade.{vert,comp}
 constexpr std::size_t kExitLawValues =
     std::size_t(SSLPV_EXIT_LAW_ALBEDO_INTERVALS + 1) * std::size_t(SSLPV_EXIT_LAW_MU_INTERVALS + 1);
 constexpr VkFormat kTriangleFormat = VK_FORMAT_R32_UINT;
@@ -27,7 +27,8 @@ void requireBytes(const Buffer& buffer, VkDeviceSize bytes, const char* what) {
 }
 
 /// The camera of shadeImage (volume/shade.cpp), in push-constant form.
-GpuShadePush shadePush(const Camera& camera, const Bounds& bounds, const GridFrame& frame, double ior) {
+GpuShadePush shadePush(const Camera& camera, const Bounds& bounds, const GridFrame& frame, double ior,
+                       std::uint32_t singleScatteringViews) {
   const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
   const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
   const glm::dvec3 up = glm::cross(right, forward);
@@ -46,7 +47,7 @@ GpuShadePush shadePush(const Camera& camera, const Bounds& bounds, const GridFra
   // medium, radiance drops by 1/η² (radiance / n² is invariant across the boundary).
   push.viewport = glm::vec4(camera.width, camera.height, 1.0 / (cellSize * cellSize * SSLPV_PI) / (ior * ior), 0.0f);
   push.gridOrigin = glm::vec4(glm::vec3(frame.origin), cellSize);
-  push.gridDims = glm::ivec4(frame.dims, 0);
+  push.gridDims = glm::ivec4(frame.dims, int(singleScatteringViews));
   return push;
 }
 
@@ -87,6 +88,23 @@ Buffer uploadExitFactors(const VulkanDevice& device, const StepFactors& factors,
   Buffer buffer(device, packed.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                 MemoryUse::Device);
   uploadToBuffer(device, buffer, packed.data(), packed.size() * sizeof(float));
+  return buffer;
+}
+
+Buffer uploadReducedMedium(const VulkanDevice& device, const MaterialGrid& material) {
+  const std::size_t cells = material.frame.cellCount();
+  if (material.sigmaT.size() != cells || material.sigmaS.size() != cells || material.g.size() != cells)
+    throw GpuError("uploadReducedMedium: the material does not match its grid frame");
+  std::vector<glm::vec4> packed(std::max<std::size_t>(cells, 1) * 2, glm::vec4(0.0f));
+  for (std::size_t i = 0; i < cells; ++i) {
+    const glm::dvec3 sigmaT(material.sigmaT[i]), sigmaS(material.sigmaS[i]);
+    const double g = material.g[i];
+    packed[2 * i] = glm::vec4(glm::vec3(sigmaT - g * sigmaS), 0.0f);
+    packed[2 * i + 1] = glm::vec4(glm::vec3((1.0 - g) * sigmaS), 0.0f);
+  }
+  Buffer buffer(device, packed.size() * sizeof(glm::vec4),
+                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Device);
+  uploadToBuffer(device, buffer, packed.data(), packed.size() * sizeof(glm::vec4));
   return buffer;
 }
 
@@ -135,7 +153,7 @@ GpuShader::GpuShader(const VulkanDevice& device, const GpuMesh& mesh, int width,
 
 void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
                        const Buffer& exitFactors, const Buffer& exitLaw, const GridFrame& frame, double ior,
-                       TimestampQueries* timestamps, std::uint32_t firstQuery) {
+                       TimestampQueries* timestamps, std::uint32_t firstQuery, const GpuSingleScattering* single) {
   if (camera.width != width_ || camera.height != height_)
     throw GpuError("GpuShader: the camera is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
                    ", the shader renders " + std::to_string(width_) + "x" + std::to_string(height_));
@@ -153,7 +171,17 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
   sets_.write(0, 6, mesh_.vertexFans());
   sets_.write(0, 7, exitFactors);
   sets_.write(0, 8, exitLaw);
-  const GpuShadePush push = shadePush(camera, mesh_.bounds(), frame, ior);
+  // Without the term its bindings still need buffers; the shader reads none of them.
+  const bool withSingle = single != nullptr && single->viewCount > 0;
+  if (withSingle) {
+    if (!single->medium || !single->views || !single->samples)
+      throw GpuError("GpuShader: the single-scattering inputs are incomplete");
+    requireBytes(*single->medium, VkDeviceSize(frame.cellCount()) * 2 * 4 * sizeof(float), "reduced medium");
+  }
+  sets_.write(0, 9, withSingle ? *single->medium : exitFactors);
+  sets_.write(0, 10, withSingle ? *single->views : exitFactors);
+  sets_.write(0, 11, withSingle ? *single->samples : exitFactors);
+  const GpuShadePush push = shadePush(camera, mesh_.bounds(), frame, ior, withSingle ? single->viewCount : 0u);
 
   if (timestamps) timestamps->write(cmd, firstQuery);
   // Earlier writes of the inputs (propagation, mesh updates) become visible, and earlier
@@ -195,10 +223,11 @@ void GpuShader::record(VkCommandBuffer cmd, const Camera& camera, const Buffer& 
 }
 
 Image GpuShader::shade(const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
-                       const Buffer& exitFactors, const Buffer& exitLaw, const GridFrame& frame, double ior) {
+                       const Buffer& exitFactors, const Buffer& exitLaw, const GridFrame& frame, double ior,
+                       const GpuSingleScattering* single) {
   VkCommandBuffer cmd = commands_.begin();
   timestamps_.reset(cmd);
-  record(cmd, camera, accumulated, cellCoverage, exitFactors, exitLaw, frame, ior, &timestamps_, 0);
+  record(cmd, camera, accumulated, cellCoverage, exitFactors, exitLaw, frame, ior, &timestamps_, 0, single);
   commands_.submitAndWait();
   lastShadeMs_ = timestamps_.readMilliseconds(2)[1];
 

@@ -42,6 +42,20 @@ Buffer uploadExitFactors(const VulkanDevice& device, const StepFactors& factors,
 /// upload once per η; shadeImage's exitLawTable(ior) on the CPU side.
 Buffer uploadExitLaw(const VulkanDevice& device, const ExitLawTable& table);
 
+/// A new device storage buffer with two vec4 per cell (binding 9 of shaders/shade.comp):
+/// (σt − g σs rgb, 0) and ((1 − g) σs rgb, 0), the similarity relation's reduced
+/// extinction and scattering the single-scattering term reads.
+Buffer uploadReducedMedium(const VulkanDevice& device, const MaterialGrid& material);
+
+/// What the single-scattering term (volume/single_scattering.h) reads: uploadReducedMedium()
+/// of the material, and a GpuShadowMapper's view records and texel records after its run.
+struct GpuSingleScattering {
+  const Buffer* medium = nullptr;
+  const Buffer* views = nullptr;
+  const Buffer* samples = nullptr;
+  std::uint32_t viewCount = 0;
+};
+
 /// Shades one camera view of one mesh. Constructed once per object and image size;
 /// record()/shade() per frame. One recording in flight at a time (record() rewrites the
 /// descriptor set).
@@ -54,19 +68,21 @@ class GpuShader {
   /// Records the shading pass into radiance(). `accumulated`: the accumulated light field
   /// of `frame` in GpuPropagator's layout; `cellCoverage`: uploadCellCoverage()
   /// (gpu/gpu_inject.h) of the material on `frame`; `exitFactors`: uploadExitFactors();
-  /// `exitLaw`: uploadExitLaw(exitLawTable(ior)). Starts with a barrier making earlier compute and
+  /// `exitLaw`: uploadExitLaw(exitLawTable(ior)); `single`: the single-scattering term's
+  /// inputs (null: no such term, as the seed scheme shades). Starts with a barrier making earlier compute and
   /// transfer writes (propagation) visible to the pass, and ends with one making
   /// radiance() visible to transfers, compute shaders and the host. The camera must have
   /// the shader's width and height. With `timestamps`, writes `firstQuery` (start) and
   /// `firstQuery + 1` (end); the caller resets them.
   void record(VkCommandBuffer cmd, const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage,
               const Buffer& exitFactors, const Buffer& exitLaw, const GridFrame& frame, double ior,
-              TimestampQueries* timestamps = nullptr, std::uint32_t firstQuery = 0);
+              TimestampQueries* timestamps = nullptr, std::uint32_t firstQuery = 0,
+              const GpuSingleScattering* single = nullptr);
 
   /// record() plus a copy into host memory, submitted and waited for; the image as
   /// shadeImage returns it (row 0 at the top, background 0).
   Image shade(const Camera& camera, const Buffer& accumulated, const Buffer& cellCoverage, const Buffer& exitFactors,
-              const Buffer& exitLaw, const GridFrame& frame, double ior);
+              const Buffer& exitLaw, const GridFrame& frame, double ior, const GpuSingleScattering* single = nullptr);
 
   /// GPU milliseconds of the shading pass in the last shade() (0 without timestamps).
   double lastShadeMs() const { return lastShadeMs_; }

@@ -15,7 +15,7 @@ constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 GpuShadowView viewRecord(const ShadowView& view, const Light& light, const ShadowBoundingSphere& sphere, double ior,
-                         std::uint32_t firstSample) {
+                         std::uint32_t firstSample, std::uint32_t lightIndex) {
   const bool perspective = view.projection == ShadowView::Projection::Perspective;
   GpuShadowView record{};
   record.origin = glm::vec4(glm::vec3(view.origin), perspective ? SSLPV_SHADOW_PERSPECTIVE : SSLPV_SHADOW_ORTHOGRAPHIC);
@@ -34,7 +34,7 @@ GpuShadowView viewRecord(const ShadowView& view, const Light& light, const Shado
   record.power = glm::vec4(directional ? light.irradiance : light.intensity,
                            spot ? spotCosHalfAngle(light) : SSLPV_SHADOW_NO_CONE);
   record.coneAxis = glm::vec4(spot ? glm::vec3(light.direction) : glm::vec3(0.0f), ior);
-  record.texels = glm::uvec4(std::uint32_t(view.size), firstSample, 0u, 0u);
+  record.texels = glm::uvec4(std::uint32_t(view.size), firstSample, lightIndex, 0u);
   return record;
 }
 
@@ -84,7 +84,8 @@ void GpuShadowMapper::setLights(const std::vector<Light>& lights, double ior) {
     info.firstSample = std::uint32_t(views.size() * texelsPerView);
     info.sampleCount = std::uint32_t(lightViews.size() * texelsPerView);
     for (const ShadowView& view : lightViews) {
-      records.push_back(viewRecord(view, light, sphere, ior, std::uint32_t(views.size() * texelsPerView)));
+      records.push_back(viewRecord(view, light, sphere, ior, std::uint32_t(views.size() * texelsPerView),
+                                   std::uint32_t(placed.size())));
       views.push_back(view);
     }
     placed.push_back(info);

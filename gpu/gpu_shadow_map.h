@@ -59,6 +59,8 @@ class GpuShadowMapper {
   double run();
 
   const Buffer& samples() const { return samples_; }
+  /// One GpuShadowView per view of every light, in views() order.
+  const Buffer& viewRecords() const { return viewRecords_; }
   /// Records in samples(): every texel of every view (hits and misses).
   std::uint32_t sampleCount() const { return sampleCount_; }
   int size() const { return size_; }

@@ -76,6 +76,9 @@ void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report)
   }
   factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
   exitFactors_ = std::make_unique<Buffer>(uploadExitFactors(device_, factors_, material_.frame));
+  reducedMedium_ = factors_.scheme == LpvScheme::Calibrated
+                       ? std::make_unique<Buffer>(uploadReducedMedium(device_, material_))
+                       : nullptr;
   calibratedInjection_ = factors_.scheme == LpvScheme::Calibrated
                          ? std::make_unique<Buffer>(uploadCalibratedInjection(device_, factors_, material_.frame))
                          : nullptr;
@@ -168,8 +171,15 @@ Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOu
       shader_ = std::make_unique<GpuShader>(device_, *mesh_, scene_.camera.width, scene_.camera.height);
     // The scene's η is fixed for the renderer: one table (built once per process and η).
     if (!exitLaw_) exitLaw_ = std::make_unique<Buffer>(uploadExitLaw(device_, exitLawTable(scene_.material.ior)));
+    GpuSingleScattering single;
+    if (reducedMedium_) {
+      single.medium = reducedMedium_.get();
+      single.views = &shadowMapper_->viewRecords();
+      single.samples = &shadowMapper_->samples();
+      single.viewCount = std::uint32_t(shadowMapper_->views().size());
+    }
     image_ = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, *exitFactors_, *exitLaw_,
-                            material_.frame, scene_.material.ior);
+                            material_.frame, scene_.material.ior, &single);
     report.times.shading = shader_->lastShadeMs();
   } else {
     report.times.markCached(Stage::Shading);

@@ -65,7 +65,9 @@ class VulkanRenderer {
   MaterialGrid material_;
   StepFactors factors_;
   std::unique_ptr<Buffer> exitFactors_;  ///< factors_' exit gain and reduced albedo on the device, for shading
-  std::unique_ptr<Buffer> calibratedInjection_;  ///< factors_' injection record (calibrated scheme), else null
+  /// factors_' reduced σt' and σs' for the single-scattering term (calibrated scheme), else null
+  std::unique_ptr<Buffer> reducedMedium_;
+    std::unique_ptr<Buffer> calibratedInjection_;  ///< factors_' injection record (calibrated scheme), else null
   std::unique_ptr<Buffer> exitLaw_;      ///< exitLawTable(scene_.material.ior), uploaded at the first shading
   std::unique_ptr<GpuVoxelizer> voxelizer_;
   std::unique_ptr<Buffer> cellCoverage_;

@@ -6,13 +6,16 @@
 // cell inside the surface (a full cell when no active cell is near) with the
 // coverage-weighted active trilinear weights of activeTrilinearWeights; radiance
 // L = T(θo)/η² · (1/(Aπ)) ∫_H G h I(ω) dω per channel, G the cell's exit gain and h its
-// exit angular shape (volume/exit_law.h; 1 in the seed scheme).
+// exit angular shape (volume/exit_law.h; 1 in the seed scheme), plus the calibrated
+// scheme's single-scattering term (volume/single_scattering.h) where it is bound.
 // Output: one vec4 per pixel, row 0 at
 // the top, (radiance, 1) on the surface (black where the ray leaves from inside or no
 // active cell is near), (0, 0, 0, 0) for the background.
 #extension GL_GOOGLE_include_directive : require
+#include "shaders/flux_sample_shared.h"
 #include "shaders/fresnel.glsl"
 #include "shaders/shade_shared.h"
+#include "shaders/shadow_map_shared.h"
 #include "volume/lpv_constants.h"
 
 #define SSLPV_CELL_COVERAGE_BINDING 3
@@ -35,6 +38,12 @@ layout(std430, set = 0, binding = 6) readonly buffer VertexFans { uint vertexFan
 layout(std430, set = 0, binding = 7) readonly buffer ExitFactors { vec4 exitFactors[]; };
 // ExitLawTable::shape of the scene's η (gpu::uploadExitLaw).
 layout(std430, set = 0, binding = 8) readonly buffer ExitLaw { float exitLaw[]; };
+// The single-scattering term's inputs (volume/single_scattering.h), read only when
+// push.gridDims.w (the number of shadow-map views) is above 0: per cell (σt' rgb, 0) and
+// (σs' rgb, 0) (gpu::uploadReducedMedium), and the shadow mapper's views and texel records.
+layout(std430, set = 0, binding = 9) readonly buffer Medium { vec4 medium[]; };
+layout(std430, set = 0, binding = 10) readonly buffer ShadowViews { GpuShadowView shadowViews[]; };
+layout(std430, set = 0, binding = 11) readonly buffer ShadowSamples { GpuFluxSample shadowSamples[]; };
 layout(push_constant) uniform Push { GpuShadePush push; };
 
 #include "shaders/ray_triangle_pick.glsl"
@@ -50,6 +59,124 @@ float exitLawShape(float albedo, int j, float fm) {
   const float a = exitLaw[low] + fm * (exitLaw[low + 1] - exitLaw[low]);
   const float b = exitLaw[high] + fm * (exitLaw[high + 1] - exitLaw[high]);
   return a + ft * (b - a);
+}
+
+// Twin of reducedMediumAt (volume/single_scattering.cpp).
+bool reducedMediumAt(CellGrid grid, vec3 q, out vec3 extinction, out vec3 scattering) {
+  uint cells[8];
+  float weights[8];
+  const int used = activeTrilinearWeights(grid, q, cells, weights);
+  extinction = vec3(0.0);
+  scattering = vec3(0.0);
+  for (int i = 0; i < used; ++i) {
+    extinction += weights[i] * medium[2u * cells[i]].xyz;
+    scattering += weights[i] * medium[2u * cells[i] + 1u].xyz;
+  }
+  return used > 0;
+}
+
+// Twin of texelThrough (volume/single_scattering.cpp): the texel record of view v whose
+// ray passes through q (-1 where q is outside the view), and q's distance along that ray.
+int texelThrough(uint v, vec3 q, out float along) {
+  const GpuShadowView view = shadowViews[v];
+  const vec3 d = q - view.origin.xyz;
+  float u, w;
+  along = 0.0;
+  if (view.origin.w == SSLPV_SHADOW_ORTHOGRAPHIC) {
+    u = dot(d, view.right.xyz) / view.forward.w;
+    w = dot(d, view.up.xyz) / view.forward.w;
+    along = dot(d, view.forward.xyz);
+  } else {
+    const float z = dot(d, view.forward.xyz);
+    if (!(z > 0.0)) return -1;
+    u = dot(d, view.right.xyz) / (z * view.forward.w);
+    w = dot(d, view.up.xyz) / (z * view.forward.w);
+    along = length(d);
+  }
+  if (!(abs(u) <= 1.0 && abs(w) <= 1.0)) return -1;
+  const int size = int(view.texels.x);
+  const int x = min(size - 1, int(0.5 * (u + 1.0) * float(size)));
+  const int y = min(size - 1, int(0.5 * (w + 1.0) * float(size)));
+  return int(view.texels.y) + y * size + x;
+}
+
+// Twin of the EntryTexel castShadowMap writes (volume/shadow_map.cpp) from a texel record
+// of view v: E T cos θi / cos θt (0 for a miss), the hit's distance along the texel ray,
+// and cos θi / cos θt.
+void entryOf(uint v, int record, out vec3 irradiance, out float distance, out float pathScale) {
+  const GpuShadowView view = shadowViews[v];
+  const GpuFluxSample texel = shadowSamples[record];
+  irradiance = vec3(0.0);
+  distance = 0.0;
+  pathScale = 0.0;
+  if (texel.positionValid.w == 0.0) return;
+  const bool orthographic = view.origin.w == SSLPV_SHADOW_ORTHOGRAPHIC;
+  const vec3 toHit = texel.positionValid.xyz - view.origin.xyz;
+  const vec3 rayDir = orthographic ? view.forward.xyz : normalize(toHit);
+  distance = orthographic ? dot(toHit, view.forward.xyz) : length(toHit);
+  const float cosI = -dot(rayDir, texel.normal.xyz);
+  const float cosT = -dot(texel.direction.xyz, texel.normal.xyz);
+  // The texel's cross-section at the hit (ShadowView::texelRay's weight, times the
+  // distance squared for a perspective map).
+  const float cosAxis = dot(rayDir, view.forward.xyz);
+  const float across = orthographic ? view.right.w * view.right.w
+                                    : view.right.w * cosAxis * cosAxis * cosAxis * distance * distance;
+  pathScale = cosT > 0.0 ? cosI / cosT : 0.0;
+  irradiance = texel.flux.rgb * (pathScale / across);
+}
+
+// Twin of singleScatteredRadiance (volume/single_scattering.cpp).
+vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
+  const float cellSize = grid.cellSize;
+  vec3 extinction0, scattering0;
+  if (!reducedMediumAt(grid, p + 0.5 * cellSize * inward, extinction0, scattering0)) return vec3(0.0);
+  const uint views = uint(push.gridDims.w);
+  vec3 result = vec3(0.0);
+  for (int ch = 0; ch < 3; ++ch) {
+    const float sigma0 = extinction0[ch];
+    if (!(sigma0 > 0.0)) continue;
+    float sum = 0.0, opticalDepth = 0.0, lastS = 0.0, lastSigma = sigma0;
+    for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
+      const float u = (float(k) + 0.5) / float(SSLPV_SINGLE_SCATTERING_SAMPLES);
+      const float s = -log(1.0 - u) / sigma0;
+      const vec3 q = p + s * into;
+      vec3 extinction, scattering;
+      if (!reducedMediumAt(grid, q, extinction, scattering)) break;
+      const float sigma = extinction[ch];
+      opticalDepth += 0.5 * (sigma + lastSigma) * (s - lastS);
+      lastS = s;
+      lastSigma = sigma;
+      float arriving = 0.0;
+      uint lastLight = 0xffffffffu;
+      for (uint v = 0u; v < views; ++v) {
+        if (shadowViews[v].texels.z == lastLight) continue;  // a cube map's other faces
+        float along;
+        const int record = texelThrough(v, q, along);
+        if (record < 0) continue;
+        lastLight = shadowViews[v].texels.z;
+        vec3 irradiance;
+        float distance, pathScale;
+        entryOf(v, record, irradiance, distance, pathScale);
+        const float below = along - distance;
+        if (irradiance[ch] == 0.0 || below < -cellSize) continue;
+        const float path = max(0.0, below) * pathScale;
+        // Where the planar estimate's entry point is not on the surface the light's map
+        // sees, q gets none of this light (singleScatteredRadiance).
+        const vec3 start = q - path * shadowSamples[record].direction.xyz;
+        float startAlong;
+        const int entry = texelThrough(v, start, startAlong);
+        if (entry < 0) continue;
+        const GpuFluxSample entered = shadowSamples[entry];
+        if (entered.positionValid.w == 0.0 || entered.flux.rgb == vec3(0.0) ||
+            length(start - entered.positionValid.xyz) > max(1.5 * cellSize, 0.5 * below))
+          continue;
+        arriving += irradiance[ch] * exp(-sigma * path);
+      }
+      sum += scattering[ch] / sigma0 * exp(sigma0 * s - opticalDepth) * arriving;
+    }
+    result[ch] = sum / (float(SSLPV_SINGLE_SCATTERING_SAMPLES) * 4.0 * float(SSLPV_PI));
+  }
+  return result;
 }
 
 void main() {
@@ -91,7 +218,11 @@ void main() {
     int used = activeTrilinearWeights(grid, p - 0.5 * cellSize * n, cells, weights);
     if (used == 0) used = activeTrilinearWeights(grid, p - cellSize * n, cells, weights);
     if (used > 0) {
-      const float scale = push.viewport.z * (1.0 - fresnelReflectance(cosOut, push.up.w));
+      const float eta = push.up.w;
+      const float transmittance = 1.0 - fresnelReflectance(cosOut, eta);
+      if (push.gridDims.w > 0 && (1.0 - cosOut * cosOut) / (eta * eta) < 1.0)
+        result.rgb = singleScatteredRadiance(grid, p, -n, refract(dir, n, 1.0 / eta)) * (transmittance / (eta * eta));
+      const float scale = push.viewport.z * transmittance;
       const float m = clamp(cosOut, 0.0, 1.0) * float(SSLPV_EXIT_LAW_MU_INTERVALS);
       const int j = min(int(m), SSLPV_EXIT_LAW_MU_INTERVALS - 1);
       const float fm = m - float(j);
@@ -103,7 +234,7 @@ void main() {
           if (albedo.w != 0.0) s *= exitLawShape(albedo[ch], j, fm);
           c += s * field[3u * cells[i] + uint(ch)];
         }
-        result[ch] = max(0.0, float(SSLPV_HEMI_Y00) * c.x + float(SSLPV_HEMI_Y1) * dot(c.yzw, n)) * scale;
+        result[ch] += max(0.0, float(SSLPV_HEMI_Y00) * c.x + float(SSLPV_HEMI_Y1) * dot(c.yzw, n)) * scale;
       }
     }
   }

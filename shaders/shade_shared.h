@@ -24,7 +24,7 @@ struct GpuShadePush {
   SSLPV_SH_VEC4 up;          ///< xyz: cross(right, forward); w: relative index of refraction η
   SSLPV_SH_VEC4 viewport;    ///< x: width, y: height (pixels); z: 1 / (A π η²), A the cell face area; w: 0
   SSLPV_SH_VEC4 gridOrigin;  ///< xyz: GridFrame::origin; w: GridFrame::cellSize
-  SSLPV_SH_IVEC4 gridDims;   ///< xyz: GridFrame::dims; w: 0
+  SSLPV_SH_IVEC4 gridDims;   ///< xyz: GridFrame::dims; w: shadow-map views the single-scattering term reads (0: none)
 };
 
 /// Workgroup of shaders/shade.comp: wide rows, as the pixels of a row are contiguous.

@@ -43,7 +43,8 @@ struct GpuShadowView {
   /// xyz: a spot's unit axis (the way it shines); w: relative index of refraction η.
   SSLPV_SM_VEC4 coneAxis;
   /// x: texels per side; y: index of the view's first texel in the sample buffer (views
-  /// are concatenated, texel (x, y) of a view at first + y * size + x); z, w: 0.
+  /// are concatenated, texel (x, y) of a view at first + y * size + x); z: index of the
+  /// view's light (a cube map's six views share it); w: 0.
   SSLPV_SM_UVEC4 texels;
 };
 

@@ -32,11 +32,13 @@
 // GPU's per-cell lookups of both are compared with the CPU's; one case without reduced
 // albedos checks that both then keep the Lambertian exit.
 #include "gpu/gpu_shade.h"
+#include "gpu/gpu_shadow_map.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <glm/trigonometric.hpp>
 #include <iostream>
 
@@ -46,6 +48,7 @@
 #include "test_meshes.h"
 #include "volume/exit_law.h"
 #include "volume/lpv_stages.h"
+#include "volume/single_scattering.h"
 #include "volume/ray_scene.h"
 #include "volume/shadow_view.h"
 #include "volume/voxelize.h"
@@ -121,20 +124,40 @@ double distanceToEdges(const TriangleMesh& mesh, unsigned triangle, const glm::d
   return nearest;
 }
 
+constexpr int kSingleScatteringMap = 128;
+
 class GpuShadeTest : public GpuTest {
  protected:
   /// Shades `o` from `camera` with both backends and checks the expectations above.
-  void compareWithCpu(const LitObject& o, const Camera& camera, double ior, const std::string& what) {
+  /// With `singleLights`, both also add the single-scattering term of those lights, each
+  /// from its own backend's shadow maps (kSingleScatteringMap texels a side).
+  void compareWithCpu(const LitObject& o, const Camera& camera, double ior, const std::string& what,
+                      const std::vector<Light>* singleLights = nullptr) {
     RayScene rays(o.mesh);
-    const Image cpu =
-        shadeImage(camera, rays, o.material, o.accumulated, ior, &o.factors.exitGain, &o.factors.reducedAlbedo);
+    std::vector<EntryMap> entries;
+    if (singleLights)
+      for (std::size_t l = 0; l < singleLights->size(); ++l)
+        castShadowMap((*singleLights)[l], rays, o.mesh.bounds(), kSingleScatteringMap, ior, nullptr, &entries, int(l));
+    const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, ior, &o.factors.exitGain,
+                                 &o.factors.reducedAlbedo, singleLights ? &entries : nullptr);
     gpu::GpuMesh mesh(device(), o.mesh);
     gpu::GpuShader shader(device(), mesh, camera.width, camera.height);
     const gpu::Buffer field = gpu::uploadLightField(device(), o.accumulated);
     const gpu::Buffer coverage = gpu::uploadCellCoverage(device(), o.material);
     const gpu::Buffer exitFactors = gpu::uploadExitFactors(device(), o.factors, o.material.frame);
     const gpu::Buffer exitLaw = gpu::uploadExitLaw(device(), exitLawTable(ior));
-    const Image gpuImage = shader.shade(camera, field, coverage, exitFactors, exitLaw, o.material.frame, ior);
+    std::optional<gpu::GpuShadowMapper> mapper;
+    std::optional<gpu::Buffer> medium;
+    gpu::GpuSingleScattering single;
+    if (singleLights) {
+      mapper.emplace(device(), mesh, kSingleScatteringMap);
+      mapper->setLights(*singleLights, ior);
+      mapper->run();
+      medium.emplace(gpu::uploadReducedMedium(device(), o.material));
+      single = {&*medium, &mapper->viewRecords(), &mapper->samples(), std::uint32_t(mapper->views().size())};
+    }
+    const Image gpuImage = shader.shade(camera, field, coverage, exitFactors, exitLaw, o.material.frame, ior,
+                                        singleLights ? &single : nullptr);
     ASSERT_EQ(gpuImage.width, cpu.width);
     ASSERT_EQ(gpuImage.height, cpu.height);
     const std::vector<std::uint32_t> gpuTriangles = shader.readTriangles(), cpuTri = cpuTriangles(camera, rays);
@@ -279,3 +302,32 @@ TEST_F(GpuShadeTest, ReportsGpuTimeOfA512ImageOfA20KTriangleSphere) {
 }
 
 }  // namespace
+
+TEST_F(GpuShadeTest, SingleScatteringMatchesTheCpuTerm) {
+  // A dense, dark medium (α' 0.2-0.3, where most of what comes back scattered once), lit
+  // by a directional and a point light (orthographic and perspective maps), seen with the
+  // single-scattering term on both backends, each reading its own shadow maps.
+  const std::vector<Light> lights = {directionalLight({0.3, -1.0, -0.4}, glm::vec3(3.0f)),
+                                     pointLight({-2.0, 1.5, 2.5}, glm::vec3(20.0f, 18.0f, 16.0f))};
+  LitObject o = lightObject(makeBoxMesh(glm::vec3(-1.0f, -0.7f, -0.5f), glm::vec3(1.2f, 1.0f, 0.5f)), lights, 1.3, 24);
+  for (glm::vec3& s : o.material.sigmaS) s *= glm::vec3(0.3f, 0.25f, 0.2f);
+  const Camera camera = cameraAt({2.2, 1.8, 3.4}, {0.1, 0.15, 0.0}, 256, 256);
+  // The term must matter, or the comparison says nothing about it.
+  RayScene rays(o.mesh);
+  std::vector<EntryMap> entries;
+  for (std::size_t l = 0; l < lights.size(); ++l)
+    castShadowMap(lights[l], rays, o.mesh.bounds(), kSingleScatteringMap, 1.3, nullptr, &entries, int(l));
+  const Image with = shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain,
+                                &o.factors.reducedAlbedo, &entries);
+  const Image without =
+      shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain, &o.factors.reducedAlbedo);
+  double added = 0.0, total = 0.0;
+  for (std::size_t i = 0; i < with.pixels.size(); ++i)
+    for (int ch = 0; ch < 3; ++ch) {
+      added += with.pixels[i][ch] - without.pixels[i][ch];
+      total += with.pixels[i][ch];
+    }
+  std::cout << "single scattering: " << 100.0 * added / total << " % of the image's light\n";
+  EXPECT_GT(added, 0.03 * total);
+  compareWithCpu(o, camera, 1.3, "box 256x256, single scattering", &lights);
+}

@@ -31,11 +31,14 @@ struct Medium {
 
 /// R_lpv of lpv_calibration.h for a medium, cell size and ior: the closed form the exit
 /// gain is built on (checked against the propagation below).
-double latticeReflectance(const Medium& medium, double cellSize, double ior) {
+/// R_lpv of light injected `depth` deep; by default where the calibrated scheme injects
+/// the medium's light (CellTransport::injectionDepth).
+double latticeReflectance(const Medium& medium, double cellSize, double ior, double depth = -1.0) {
   const double kappa = medium.kappa() * cellSize;
   const double s = 3.0 / (2.0 + std::cosh(kappa)), r = std::exp(-kappa);
   const double rho = boundaryRetention(2.0 * diffusionBoundaryCoefficient(ior) / (3.0 * medium.sigmaT()), cellSize);
-  const double layer = std::max(1.0 / medium.sigmaT(), 0.5 * cellSize) / cellSize + 0.5;
+  if (depth < 0.0) depth = calibratedTransport(medium.sigmaT(), medium.sigmaSPrime, 0.0, cellSize, ior).injectionDepth;
+  const double layer = std::max(depth, 0.5 * cellSize) / cellSize + 0.5;
   const double m = std::floor(layer), f = layer - m;
   return 3.0 * std::pow(r, m) * (1.0 - f + f * r) / (s * (1.0 - rho * r));
 }
@@ -246,7 +249,9 @@ TEST(LpvCalibration, ExitGainMakesTheLatticeReflectTheMediumsRd) {
           const CellTransport t = calibratedTransport(medium.sigmaA + sigmaS, sigmaS, g, cellSize, ior);
           const double reflected = t.exitGain * latticeReflectance(medium, cellSize, ior) *
                                    (1.0 - fresnelReflectance(1.0, ior)) * diffuseBoundaryTransmittance(ior);
-          const double rd = boundaryReflectance(medium.albedo(), ior);
+          // The lattice carries Rd less the once-scattered light the shading adds itself.
+          const double rd = boundaryReflectance(medium.albedo(), ior) -
+                            (1.0 - fresnelReflectance(1.0, ior)) * singleScatteringPerEntering(medium.albedo(), ior, 1.0);
           EXPECT_NEAR(reflected, rd, 1e-6 * rd)
               << "ior " << ior << " sigma_s' " << medium.sigmaSPrime << " g " << g << " cell " << cellSize;
         }
@@ -275,7 +280,8 @@ TEST(LpvCalibration, ObliqueEntryGainMakesTheLatticeReflectTheMediumsRdAtEveryAn
     AddingDoublingOptions options;
     options.beamCosine = cosRefracted;
     const double medium = addingDoublingHalfSpace(skin.albedo(), ior, options).rd /
-                          (1.0 - fresnelReflectance(std::sqrt(incidence), ior));
+                              (1.0 - fresnelReflectance(std::sqrt(incidence), ior)) -
+                          singleScatteringPerEntering(skin.albedo(), ior, cosRefracted);
     EXPECT_NEAR(reflected, medium, tolerance * medium) << "cos^2 of incidence " << incidence;
   }
 }
@@ -292,13 +298,17 @@ TEST(LpvCalibration, ObliqueRatioTableMatchesAddingDoubling) {
       const auto perEntering = [&](double incidence) {
         AddingDoublingOptions options;
         options.beamCosine = std::sqrt(1.0 - (1.0 - incidence) / (ior * ior));
-        return addingDoublingHalfSpace(albedo, ior, options).rd / (1.0 - fresnelReflectance(std::sqrt(incidence), ior));
+        return addingDoublingHalfSpace(albedo, ior, options).rd / (1.0 - fresnelReflectance(std::sqrt(incidence), ior)) -
+               singleScatteringPerEntering(albedo, ior, options.beamCosine);
       };
       for (int k = 1; k <= kObliqueIntervals; ++k) {
         // The grazing node holds cos θi = 0.03 (and for η < 1 nothing flatter than enters).
         const double incidence = std::max(1.0 - double(k) / kObliqueIntervals, 0.03 * 0.03);
         const double expected = perEntering(incidence) / perEntering(1.0);
-        EXPECT_NEAR(wide.obliqueGain[std::size_t(k - 1)], expected, 1e-4 * expected)
+        // Without the once-scattered light the grazing node's ratio bends fast as α' -> 0
+        // at η = 1: 2e-3 there (measured 4e-4 and 2.1e-3 at α' 0.09 and 0.03).
+        const double tolerance = albedo < 0.1 ? 3e-3 : 1e-4;
+        EXPECT_NEAR(wide.obliqueGain[std::size_t(k - 1)], expected, tolerance * expected)
             << "ior " << ior << " albedo " << albedo << " node " << k;
       }
     }

@@ -8,6 +8,7 @@
 #include "volume/material_set.h"
 #include "volume/mesh.h"
 #include "volume/ray_scene.h"
+#include "volume/single_scattering.h"
 #include "volume/voxelize_parity.h"
 
 namespace sslpv {
@@ -93,11 +94,13 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::ShadowMap)) {
     samples_.clear();
+    entries_.clear();
     report.lights.clear();
-    for (const Light& light : scene_.lights) {
+    for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
+      const Light& light = scene_.lights[l];
       ShadowMapStats stats;
-      auto lightSamples =
-          castShadowMap(light, *rays_, object_.bounds(), settings.shadowMap, scene_.material.ior, &stats);
+      auto lightSamples = castShadowMap(light, *rays_, object_.bounds(), settings.shadowMap, scene_.material.ior,
+                                        &stats, &entries_, int(l));
       samples_.insert(samples_.end(), lightSamples.begin(), lightSamples.end());
       report.lights.push_back(stats);
     }
@@ -131,7 +134,8 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::Shading)) {
     image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
-                        &factors_.reducedAlbedo);
+                        &factors_.reducedAlbedo,
+                        factors_.scheme == LpvScheme::Calibrated ? &entries_ : nullptr);
     report.times.shading = watch.lapMs();
   } else {
     report.times.markCached(Stage::Shading);

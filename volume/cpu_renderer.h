@@ -11,6 +11,7 @@
 #include "volume/lpv_stages.h"
 #include "volume/scene.h"
 #include "volume/scene_object.h"
+#include "volume/single_scattering.h"
 
 namespace sslpv {
 
@@ -51,6 +52,7 @@ class CpuRenderer {
   MaterialGrid material_;
   StepFactors factors_;
   std::vector<SurfaceFluxSample> samples_;
+  std::vector<EntryMap> entries_;  ///< the shadow maps' texels for the single-scattering term
   ShGrid injected_, accumulated_;
   RenderReport last_;
   Image image_;

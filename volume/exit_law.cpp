@@ -1,6 +1,8 @@
 // The calibrated exit law's table; the model and its reasons are in exit_law.h.
 #include "volume/exit_law.h"
 
+#include "volume/lpv_calibration.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -147,15 +149,22 @@ ExactExitShape::ExactExitShape(double reducedAlbedo, double ior, int nodes) : et
   checkIor(ior);
   AddingDoublingOptions options;
   options.nodes = nodes;
-  const HalfSpaceReflectance solution =
-      addingDoublingHalfSpace(std::clamp(reducedAlbedo, kSmallestAlbedo, 1.0), ior, options);
+  const double albedo = std::clamp(reducedAlbedo, kSmallestAlbedo, 1.0);
+  const HalfSpaceReflectance solution = addingDoublingHalfSpace(albedo, ior, options);
   muC_ = ior > 1.0 ? std::sqrt(1.0 - 1.0 / (ior * ior)) : 0.0;
+  // With explicit single scattering the lattice carries only the light that scattered
+  // more than once: the once-scattered radiance arriving from below, 2π L₁ = α' (1 − F(0))
+  // / (2 (1 + μ)) per unit irradiance, is not its to shape.
+  const double single = albedo * (1.0 - fresnelReflectance(1.0, ior));
   for (std::size_t i = 0; i < solution.mu.size(); ++i) {
     const double mu = solution.mu[i];
     if (mu <= muC_) continue;  // totally reflected: never leaves
     x_.push_back(variable(mu));
-    y_.push_back(solution.upward[i] / (solution.weight[i] * mu));
+    y_.push_back(std::max(0.0, solution.upward[i] / (solution.weight[i] * mu) - single / (2.0 * (1.0 + mu))));
   }
+  // Where nothing is left after the once-scattered light (α' -> 0), the shape of what
+  // little remains is immaterial: keep it Lambertian rather than divide by zero.
+  if (*std::max_element(y_.begin(), y_.end()) <= 0.0) std::fill(y_.begin(), y_.end(), 1.0);
   // Barycentric weights 1 / Π (x_j - x_k): the nodes are Gauss points in the variable,
   // which keeps the polynomial interpolant well conditioned.
   for (std::size_t j = 0; j < x_.size(); ++j) {

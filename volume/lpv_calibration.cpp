@@ -54,11 +54,15 @@ struct BoundaryTable {
   /// t = i / kObliqueAlbedoIntervals: the medium's diffuse reflectance per entering power
   /// at that incidence relative to normal incidence.
   std::array<std::vector<double>, kObliqueIntervals> obliqueRatio;
+  /// singleScatteringPerEntering / albedo: at normal incidence, and per oblique node.
+  double singleNormal = 0.0;
+  std::array<double, kObliqueIntervals> singleOblique{};
+  double secondScattering = 1.0;  ///< secondScatteringDepth(ior)
 };
 
 /// The oblique ratio varies slowly with the albedo, so 16 intervals (cubic) reproduce
 /// adding-doubling to 1e-5 (lpv_calibration_test) and the table costs ~25 ms per ior.
-constexpr int kObliqueAlbedoIntervals = 16;
+constexpr int kObliqueAlbedoIntervals = 32;
 
 /// cos² θi at which a node is evaluated: the grazing node (y = 0) lets no power in, so it
 /// holds the value at cos θi = 0.03; for η < 1, light arriving flatter than the critical
@@ -77,11 +81,13 @@ double obliqueNodeDepth(double injectionDepth, double ior, int k) {
   return injectionDepth * refractedCosine(obliqueNodeCosineSquared(k, ior), ior);
 }
 
-/// Diffusely reflected power per entering power of a beam entering at cos² θi = y.
+/// Diffusely reflected power per entering power of a beam entering at cos² θi = y, less
+/// the once-scattered share the shading adds itself (singleScatteringPerEntering).
 double reflectancePerEntering(double albedo, double ior, double y) {
   AddingDoublingOptions options;
   options.beamCosine = refractedCosine(y, ior);
-  return addingDoublingHalfSpace(albedo, ior, options).rd / (1.0 - fresnelReflectance(std::sqrt(y), ior));
+  return addingDoublingHalfSpace(albedo, ior, options).rd / (1.0 - fresnelReflectance(std::sqrt(y), ior)) -
+         singleScatteringPerEntering(albedo, ior, options.beamCosine);
 }
 
 std::unique_ptr<const BoundaryTable> buildBoundaryTable(double ior) {
@@ -98,22 +104,28 @@ std::unique_ptr<const BoundaryTable> buildBoundaryTable(double ior) {
         i == 0 ? 1.0 - fresnelReflectance(1.0, ior) : addingDoublingHalfSpace(albedo, ior).rd / albedo;
   }
   table->entering = 1.0 - fresnelReflectance(1.0, ior);
-  // The oblique albedos are every (kReflectanceTable / kObliqueAlbedoIntervals)-th of the
-  // Rd table's, so normal incidence comes from it rather than from adding-doubling again.
-  static_assert(kReflectanceTable % kObliqueAlbedoIntervals == 0, "oblique albedos must be Rd table nodes");
-  constexpr int kStride = kReflectanceTable / kObliqueAlbedoIntervals;
+  table->singleNormal = singleScatteringPerEntering(1.0, ior, 1.0);
+  table->secondScattering = secondScatteringDepth(ior);
+  for (int k = 1; k <= kObliqueIntervals; ++k)
+    table->singleOblique[std::size_t(k - 1)] =
+        singleScatteringPerEntering(1.0, ior, refractedCosine(obliqueNodeCosineSquared(k, ior), ior));
+  // Without its once-scattered light the share left is ∝ α'² as α' -> 0, and its ratio
+  // tends to a limit (twice-scattered light's) that α' = 1e-3 gives to ~1e-3.
+  const auto obliqueAlbedo = [](int i) {
+    const double t = double(i) / kObliqueAlbedoIntervals;
+    return std::max(1e-3, 1.0 - t * t);
+  };
+  std::vector<double> normal(kObliqueAlbedoIntervals + 1);
+  for (int i = 1; i <= kObliqueAlbedoIntervals; ++i)
+    normal[std::size_t(i)] = reflectancePerEntering(obliqueAlbedo(i), ior, 1.0);
   for (int k = 1; k <= kObliqueIntervals; ++k) {
     std::vector<double>& ratio = table->obliqueRatio[std::size_t(k - 1)];
     ratio.resize(kObliqueAlbedoIntervals + 1);
     const double y = obliqueNodeCosineSquared(k, ior);
     // t = 0: a non-absorbing half-space returns all that enters, at any angle.
-    ratio[0] = 1.0;
-    for (int i = 1; i <= kObliqueAlbedoIntervals; ++i) {
-      const double t = double(i) / kObliqueAlbedoIntervals;
-      const double albedo = std::max(1e-9, 1.0 - t * t);
-      const double normal = table->rdOverAlbedo[std::size_t(i * kStride)] * albedo / table->entering;
-      ratio[std::size_t(i)] = reflectancePerEntering(albedo, ior, y) / normal;
-    }
+    ratio[0] = (1.0 - table->singleOblique[std::size_t(k - 1)]) / (1.0 - table->singleNormal);
+    for (int i = 1; i <= kObliqueAlbedoIntervals; ++i)
+      ratio[std::size_t(i)] = reflectancePerEntering(obliqueAlbedo(i), ior, y) / normal[std::size_t(i)];
   }
   table->leaving = diffuseBoundaryTransmittance(ior);
   table->extrapolation = 2.0 * diffusionBoundaryCoefficient(ior) / 3.0;
@@ -207,6 +219,26 @@ double boundaryReflectance(double albedo, double ior) {
 }
 
 double halfSpaceReflectance(double albedo) { return boundaryReflectance(albedo, 1.0); }
+
+double singleScatteringPerEntering(double albedo, double ior, double beamCosine) {
+  // (α'/2) ∫ T(μ) μ / (μ + μt) dμ over the inside directions that leave (μ above the
+  // critical cosine). T rises as sqrt(μ − μc) there, so Gauss-Legendre runs in t with
+  // μ = μc + (1 − μc) t², dμ = 2 (1 − μc) t dt, where the integrand is smooth.
+  const double muC = ior > 1.0 ? std::sqrt(1.0 - 1.0 / (ior * ior)) : 0.0;
+  static const std::array<double, 8> x = {0.0950125098, 0.2816035508, 0.4580167777, 0.6178762444,
+                                          0.7554044084, 0.8656312024, 0.9445750231, 0.9894009350};
+  static const std::array<double, 8> w = {0.1894506105, 0.1826034150, 0.1691565194, 0.1495959888,
+                                          0.1246289713, 0.0951585117, 0.0622535239, 0.0271524594};
+  double sum = 0.0;
+  for (int i = 0; i < 8; ++i)
+    for (int sign = -1; sign <= 1; sign += 2) {
+      const double t = 0.5 + 0.5 * sign * x[std::size_t(i)];
+      const double mu = muC + (1.0 - muC) * t * t;
+      sum += w[std::size_t(i)] * 0.5 * 2.0 * (1.0 - muC) * t * (1.0 - fresnelReflectanceFromInside(mu, ior)) * mu /
+             (mu + beamCosine);
+    }
+  return 0.5 * std::clamp(albedo, 0.0, 1.0) * sum;
+}
 
 double incidentCosineSquared(double cosRefracted, double ior) {
   return std::clamp(1.0 - ior * ior * (1.0 - cosRefracted * cosRefracted), 0.0, 1.0);
@@ -343,6 +375,31 @@ CellTransport seedTransport(double sigmaT, double sigmaS, double g, double cellS
   return t;
 }
 
+double secondScatteringDepth(double ior) {
+  if (!(ior > 0.0) || !std::isfinite(ior)) throw std::invalid_argument("secondScatteringDepth: ior must be positive");
+  // First scattering at depth z ~ e^-z (mean free paths), a flight of length l ~ e^-l at
+  // cosine μ to the inward normal, uniform in [-1, 1]. Downward (μ > 0) it scatters again
+  // at z + μ l; upward (μ = -ν) at z − ν l when ν l < z, else it meets the boundary, which
+  // reflects R(ν) of it to scatter at ν l − z (the rest leaves: single scattering). Over l:
+  // downward E = z + μ; upward, staying: z (1 − e^-a) − ν (1 − e^-a (1 + a)), a = z / ν,
+  // with weight 1 − e^-a; reflected: ν e^-a, weight e^-a. Midpoints in u = 1 − e^-z and ν.
+  constexpr int kDepths = 400, kCosines = 400;
+  double depthSum = 0.0, weightSum = 0.0;
+  for (int i = 0; i < kDepths; ++i) {
+    const double z = -std::log1p(-(i + 0.5) / kDepths);  // e^-z dz = du
+    double depth = 0.5 * (z + 0.5), weight = 0.5;           // downward half
+    for (int j = 0; j < kCosines; ++j) {
+      const double nu = (j + 0.5) / kCosines, a = z / nu, e = std::exp(-a);
+      const double reflected = fresnelReflectanceFromInside(nu, ior);
+      depth += 0.5 / kCosines * (z * (1.0 - e) - nu * (1.0 - e * (1.0 + a)) + reflected * nu * e);
+      weight += 0.5 / kCosines * (1.0 - e + reflected * e);
+    }
+    depthSum += depth;
+    weightSum += weight;
+  }
+  return depthSum / weightSum;
+}
+
 CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double cellSize, double ior) {
   const double sigmaA = std::max(0.0, sigmaT - sigmaS);
   const double reducedS = std::max(0.0, sigmaS) * (1.0 - g);
@@ -357,7 +414,7 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
   // injection stays at its floor.
   const double retention =
       reducedT > 0.0 ? boundaryRetention(boundary.extrapolation / reducedT, cellSize) : kMaxRetention;
-  const double injectionDepth = reducedT > 0.0 ? 1.0 / reducedT : 0.0;
+  const double firstScatterDepth = reducedT > 0.0 ? 1.0 / reducedT : 0.0;
   // R_lpv of light injected `depth` deep (the derivation at the top of this file).
   const auto layerOf = [&](double depth) { return std::max(depth, 0.5 * cellSize) / cellSize + 0.5; };
   const auto latticeReflectanceAt = [&](double depth) {
@@ -366,11 +423,16 @@ CellTransport calibratedTransport(double sigmaT, double sigmaS, double g, double
     const double first = std::floor(layer), deeper = layer - first;
     return 3.0 * std::pow(r, first) * (1.0 - deeper + deeper * r) / (survival * (1.0 - retention * r));
   };
-  const double latticeReflectance = latticeReflectanceAt(injectionDepth);
   // The injection has already taken 1 - F(0) of the irradiance and the shading lets out
   // `leaving` of an isotropic cell's power, so this gain makes the lattice reflect the
-  // medium's Rd in total.
-  const double target = boundaryReflectance(reducedAlbedo, ior) / (boundary.entering * boundary.leaving);
+  // medium's Rd less the once-scattered light the shading adds itself (single_scattering.h).
+  const double target = (boundaryReflectance(reducedAlbedo, ior) / boundary.entering -
+                         boundary.singleNormal * std::clamp(reducedAlbedo, 0.0, 1.0)) /
+                        boundary.leaving;
+  // The lattice's light has scattered at least twice: it starts where the second
+  // scattering happens on average.
+  const double injectionDepth = boundary.secondScattering * firstScatterDepth;
+  const double latticeReflectance = latticeReflectanceAt(injectionDepth);
   double gain = latticeReflectance > 0.0 ? target / latticeReflectance : 0.0;
   if (!std::isfinite(gain) || reducedAlbedo <= 0.0) gain = 0.0;
   CellTransport t;

@@ -64,4 +64,8 @@
 // piecewise linear in y.
 #define SSLPV_OBLIQUE_INTERVALS 4
 
+// The calibrated shading's single-scattering term (volume/single_scattering.h): samples
+// per channel along the refracted view ray, midpoints in u = 1 - exp(-sigma_t' s).
+#define SSLPV_SINGLE_SCATTERING_SAMPLES 8
+
 #endif

@@ -15,6 +15,7 @@ namespace sslpv {
 
 class RayScene;
 struct Image;
+struct EntryMap;
 
 /// Light that crossed the surface at one shadow-map texel.
 struct SurfaceFluxSample {
@@ -37,9 +38,12 @@ struct ShadowMapStats {
 /// for relative index `ior`. Point and spot lights use a perspective map aimed at the
 /// object (a cube map when the light is inside its bounding sphere); directional lights
 /// an orthographic map. Lights that cannot reach the object return nothing (culled).
+/// With `entries`, also appends each view's every texel as the single-scattering term
+/// reads it (volume/single_scattering.h), tagged `lightIndex`.
 std::vector<SurfaceFluxSample> castShadowMap(const Light& light, const RayScene& rays,
                                              const Bounds& bounds, int size, double ior,
-                                             ShadowMapStats* stats = nullptr);
+                                             ShadowMapStats* stats = nullptr,
+                                             std::vector<EntryMap>* entries = nullptr, int lightIndex = 0);
 
 /// Trilinear weights of the 8 cells around world point p (continuous cell coordinates,
 /// cell centres at half-integers) times each cell's coverage, restricted to active cells and
@@ -232,6 +236,7 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
                  const ShGrid& accumulated, double ior,
                  const std::array<std::vector<float>, 3>* exitGain = nullptr,
-                 const std::array<std::vector<float>, 3>* reducedAlbedo = nullptr);
+                 const std::array<std::vector<float>, 3>* reducedAlbedo = nullptr,
+                 const std::vector<EntryMap>* singleScattering = nullptr);
 
 }  // namespace sslpv

@@ -12,12 +12,14 @@
 #include "volume/lpv_stages.h"
 #include "volume/ray_scene.h"
 #include "volume/sh.h"
+#include "volume/single_scattering.h"
 
 namespace sslpv {
 
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
                  const ShGrid& accumulated, double ior, const std::array<std::vector<float>, 3>* exitGain,
-                 const std::array<std::vector<float>, 3>* reducedAlbedo) {
+                 const std::array<std::vector<float>, 3>* reducedAlbedo,
+                 const std::vector<EntryMap>* singleScattering) {
   // The calibrated exit law weights each cell by its medium's exit shape (exit_law.h).
   const bool exitLaw = reducedAlbedo != nullptr && !(*reducedAlbedo)[0].empty();
   const ExitLawTable* law = exitLaw ? &exitLawTable(ior) : nullptr;
@@ -71,6 +73,13 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
         const double transmittance = 1.0 - fresnelReflectance(cosOut, ior);
         const ExitLawColumn column = exitLawColumn(float(cosOut));
         glm::vec3 radiance(0.0f);
+        if (singleScattering != nullptr && !singleScattering->empty()) {
+          const double sinT2 = (1.0 - cosOut * cosOut) / (ior * ior);
+          if (sinT2 < 1.0)
+            radiance = singleScatteredRadiance(material, *singleScattering, p, -n,
+                                               refractInto(glm::dvec3(dirs[x]), n, ior)) *
+                       float(boundaryScale * transmittance);
+        }
         for (int ch = 0; ch < 3; ++ch) {
           sh::Coeffs c(0.0f);
           for (int i = 0; i < used; ++i) {
@@ -81,7 +90,7 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
                                     accumulated.plane(ch, 2)[cell], accumulated.plane(ch, 3)[cell]);
           }
           const double exitant = std::max(0.0f, sh::hemisphereIntegral(c, glm::vec3(n)));
-          radiance[ch] = float(exitant * radianceScale * boundaryScale * transmittance);
+          radiance[ch] += float(exitant * radianceScale * boundaryScale * transmittance);
         }
         image.at(x, y) = radiance;
       }

@@ -12,6 +12,7 @@
 #include "volume/lpv_stages.h"
 #include "volume/ray_scene.h"
 #include "volume/shadow_view.h"
+#include "volume/single_scattering.h"
 
 namespace sslpv {
 namespace {
@@ -40,9 +41,14 @@ class ShadowCaster {
   ShadowCaster(const Light& light, const RayScene& rays, double ior)
       : light_(light), rays_(rays), ior_(ior), spotCosHalf_(spotCosHalfAngle(light)) {}
 
-  void cast(const ShadowView& view, std::vector<SurfaceFluxSample>& out, ShadowMapStats& stats) const {
+  void cast(const ShadowView& view, std::vector<SurfaceFluxSample>& out, ShadowMapStats& stats,
+            EntryMap* entry) const {
     const int size = view.size;
     const std::size_t texels = std::size_t(size) * size;
+    if (entry) {
+      entry->view = view;
+      entry->texels.assign(texels, EntryTexel{});
+    }
     std::vector<SurfaceFluxSample> samples(texels);
     std::vector<unsigned char> valid(texels, 0);
     std::vector<glm::dvec3> incident(texels, glm::dvec3(0.0));
@@ -72,6 +78,18 @@ class ShadowCaster {
                                          power * float(transmittance)};
           incident[i] = glm::dvec3(power);
           valid[i] = 1;
+          if (entry) {
+            // Across the refracted beam: the texel's power over its cross-section at the hit
+            // (its area, or its solid angle times the distance squared), compressed by
+            // cos θi / cos θt.
+            const double cosT = -glm::dot(glm::dvec3(samples[i].direction), n);
+            const double across =
+                view.projection == ShadowView::Projection::Orthographic ? ray.weight : ray.weight * hit.t * hit.t;
+            const double scale = cosT > 0.0 ? cosI / cosT : 0.0;
+            entry->texels[i] = EntryTexel{hit.position, float(scale),
+                                          glm::vec3(glm::dvec3(samples[i].flux) * (scale / across)), float(hit.t),
+                                          hit.normal, samples[i].direction};
+          }
         }
       }
     });
@@ -158,13 +176,22 @@ std::vector<ShadowView> planShadowViews(const Light& light, const Bounds& bounds
 }
 
 std::vector<SurfaceFluxSample> castShadowMap(const Light& light, const RayScene& rays, const Bounds& bounds, int size,
-                                             double ior, ShadowMapStats* statsOut) {
+                                             double ior, ShadowMapStats* statsOut, std::vector<EntryMap>* entries,
+                                             int lightIndex) {
   ShadowMapStats stats;
   std::vector<SurfaceFluxSample> samples;
   const std::vector<ShadowView> views = planShadowViews(light, bounds, size);
   stats.culled = views.empty();
   const ShadowCaster caster(light, rays, ior);
-  for (const ShadowView& view : views) caster.cast(view, samples, stats);
+  for (const ShadowView& view : views) {
+    EntryMap* entry = nullptr;
+    if (entries) {
+      entries->emplace_back();
+      entry = &entries->back();
+      entry->light = lightIndex;
+    }
+    caster.cast(view, samples, stats, entry);
+  }
   if (statsOut) *statsOut = stats;
   return samples;
 }

@@ -1,0 +1,113 @@
+#include "volume/single_scattering.h"
+
+#include <cmath>
+#include <glm/geometric.hpp>
+
+#include "volume/lpv_constants.h"
+#include "volume/lpv_stages.h"
+
+namespace sslpv {
+namespace {
+
+struct ReducedMedium {
+  glm::dvec3 extinction{0.0};  ///< σt' per channel
+  glm::dvec3 scattering{0.0};  ///< σs' per channel
+};
+
+/// σt' and σs' at q with the shading's coverage-weighted trilinear weights; false where no
+/// active cell is near (q has left the object).
+bool reducedMediumAt(const MaterialGrid& material, const glm::dvec3& q, ReducedMedium& out) {
+  std::size_t cells[8];
+  float weights[8];
+  const int used = activeTrilinearWeights(material, q, cells, weights);
+  if (used == 0) return false;
+  out = ReducedMedium{};
+  for (int i = 0; i < used; ++i) {
+    const glm::dvec3 sigmaT(material.sigmaT[cells[i]]), sigmaS(material.sigmaS[cells[i]]);
+    const double g = material.g[cells[i]];
+    out.extinction += double(weights[i]) * (sigmaT - g * sigmaS);
+    out.scattering += double(weights[i]) * (1.0 - g) * sigmaS;
+  }
+  return true;
+}
+
+/// The texel of `map` whose ray passes through q, or null where q is outside the view.
+/// `along` receives q's distance along that ray, measured as EntryTexel::distance is.
+const EntryTexel* texelThrough(const EntryMap& map, const glm::dvec3& q, double& along) {
+  const ShadowView& view = map.view;
+  const glm::dvec3 d = q - view.origin;
+  double u, v;
+  if (view.projection == ShadowView::Projection::Orthographic) {
+    u = glm::dot(d, view.right) / view.halfSize;
+    v = glm::dot(d, view.up) / view.halfSize;
+    along = glm::dot(d, view.forward);
+  } else {
+    const double z = glm::dot(d, view.forward);
+    if (!(z > 0.0)) return nullptr;
+    u = glm::dot(d, view.right) / (z * view.tanHalf);
+    v = glm::dot(d, view.up) / (z * view.tanHalf);
+    along = glm::length(d);
+  }
+  if (!(std::abs(u) <= 1.0 && std::abs(v) <= 1.0)) return nullptr;
+  const int x = std::min(view.size - 1, int(0.5 * (u + 1.0) * view.size));
+  const int y = std::min(view.size - 1, int(0.5 * (v + 1.0) * view.size));
+  return &map.texels[std::size_t(y) * std::size_t(view.size) + std::size_t(x)];
+}
+
+}  // namespace
+
+glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
+                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into) {
+  const double cellSize = material.frame.cellSize;
+  ReducedMedium surface;
+  if (!reducedMediumAt(material, p + 0.5 * cellSize * inward, surface)) return glm::vec3(0.0f);
+  glm::vec3 radiance(0.0f);
+  for (int ch = 0; ch < 3; ++ch) {
+    const double sigma0 = surface.extinction[ch];
+    if (!(sigma0 > 0.0)) continue;
+    double sum = 0.0, opticalDepth = 0.0, lastS = 0.0, lastSigma = sigma0;
+    for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
+      const double u = (k + 0.5) / SSLPV_SINGLE_SCATTERING_SAMPLES;
+      const double s = -std::log1p(-u) / sigma0;
+      const glm::dvec3 q = p + s * into;
+      ReducedMedium medium;
+      if (!reducedMediumAt(material, q, medium)) break;
+      const double sigma = medium.extinction[ch];
+      opticalDepth += 0.5 * (sigma + lastSigma) * (s - lastS);
+      lastS = s;
+      lastSigma = sigma;
+      double arriving = 0.0;
+      int lastLight = -1;
+      for (const EntryMap& map : maps) {
+        if (map.light == lastLight) continue;  // a cube map's other faces
+        double along = 0.0;
+        const EntryTexel* texel = texelThrough(map, q, along);
+        if (texel == nullptr) continue;
+        lastLight = map.light;
+        if (texel->irradiance[ch] == 0.0f) continue;
+        // q can sit up to a texel in front of its entry point; light that would reach q
+        // from in front of the surface by more than a cell went round the object.
+        const double below = along - double(texel->distance);
+        if (below < -cellSize) continue;
+        const double path = std::max(0.0, below) * texel->pathScale;
+        // The planar estimate puts the entry of the beam that reaches q at q − path·d_t.
+        // Where the surface curves away from the entry's tangent plane (past the light's
+        // terminator, behind a grazing entry) that point is not where light enters: the
+        // light's own map sees its surface elsewhere, and q gets none of this light.
+        double entryAlong = 0.0;
+        const glm::dvec3 start = q - path * glm::dvec3(texel->direction);
+        const EntryTexel* entry = texelThrough(map, start, entryAlong);
+        if (entry == nullptr || entry->irradiance == glm::vec3(0.0f) ||
+            glm::length(start - glm::dvec3(entry->position)) > std::max(1.5 * cellSize, 0.5 * below))
+          continue;
+        arriving += texel->irradiance[ch] * std::exp(-sigma * path);
+      }
+      // ∫ σs' e^{-τ} f ds in the variable u: ds = du / (σ0 (1 − u)), and 1 − u = e^{-σ0 s}.
+      sum += medium.scattering[ch] / sigma0 * std::exp(sigma0 * s - opticalDepth) * arriving;
+    }
+    radiance[ch] = float(sum / (SSLPV_SINGLE_SCATTERING_SAMPLES * 4.0 * SSLPV_PI));
+  }
+  return radiance;
+}
+
+}  // namespace sslpv

@@ -1,0 +1,56 @@
+#pragma once
+// The calibrated shading's single-scattering term (issue 4): light that scatters exactly
+// once between entering the object and leaving it toward the camera, integrated per pixel
+// along the refracted view ray instead of carried by the lattice.
+//
+// Why: at low reduced albedo α' nearly all the light a medium returns has scattered once
+// (ketchup green and blue, α' 0.07 and 0.02), and where it comes out depends on the
+// geometry on the scale of a mean free path: round a lit edge it leaves the unlit face
+// within 1/σt' of the edge. The lattice spreads it as diffusion from an isotropic source
+// z0 deep, which put a band of light about z0 below the edge (1.5-2x the path tracer's on
+// ketchup green and blue, bench/edge_crossing) and left the first millimetre dark. The
+// single-scattered light has a closed form per point, so the shading integrates it, and
+// the lattice's coupling gain targets the rest of the thick slab's reflectance,
+// Rd − Rd₁ (singleScatteringPerEntering, lpv_calibration.h).
+//
+// The term, with the similarity relation's isotropic medium (σs' = σs (1 − g),
+// σt' = σt − g σs, as the calibration uses): along the refracted view ray t from the
+// surface point p, L(p, −t) = ∫ σs'(q) / (4π) Σ_lights E_in(q) exp(−σt'(q) s'_l(q))
+// exp(−τ(p, q)) ds, q = p + s t, and the camera sees T(θo) / η² of it. E_in is the light's
+// irradiance refracted into the medium across its beam, E T(θi) cos θi / cos θt, and s'_l
+// the refracted path from the light's entry point to q, Jensen et al.'s (2001) planar
+// estimate s cos θi / cos θt from the straight distance s to the surface along the
+// light's ray, which the light's shadow map gives (its texel's entry point). The light leg
+// takes σt' at q; the view leg integrates σt' along the ray. Samples are midpoints in
+// u = 1 − exp(−σt'(p) s), so a homogeneous medium's view-leg attenuation is exact.
+#include <glm/vec3.hpp>
+#include <vector>
+
+#include "volume/lpv_grid.h"
+#include "volume/shadow_view.h"
+
+namespace sslpv {
+
+/// What the single-scattering term reads of one shadow-map texel.
+struct EntryTexel {
+  glm::vec3 position{0.0f};   ///< where the texel's ray meets the surface
+  float pathScale = 0.0f;     ///< cos θi / cos θt: refracted path per straight distance below the surface
+  glm::vec3 irradiance{0.0f}; ///< E T(θi) cos θi / cos θt per channel; 0 for a miss or no light
+  float distance = 0.0f;      ///< of the hit along the texel ray (orthographic: from its start plane)
+  glm::vec3 normal{0.0f};     ///< outward unit normal at the entry point
+  glm::vec3 direction{0.0f};  ///< unit refracted direction of the light inside
+};
+
+/// Every texel of one shadow-map view, row by row as ShadowView orders them.
+struct EntryMap {
+  ShadowView view;
+  int light = 0;  ///< index of the view's light (a cube map has six views of one light)
+  std::vector<EntryTexel> texels;
+};
+
+/// L(p, −t) above, per channel, inside the boundary: `into` is the refracted view
+/// direction (unit, into the medium), `inward` the inward unit normal at p.
+glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
+                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into);
+
+}  // namespace sslpv
