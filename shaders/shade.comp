@@ -125,28 +125,61 @@ void entryOf(uint v, int record, out vec3 irradiance, out float distance, out fl
   irradiance = texel.flux.rgb * (pathScale / across);
 }
 
+// Twin of singleScatteringGroups (volume/single_scattering.cpp): channels sorted by
+// σt', a new group wherever one exceeds SSLPV_SINGLE_SCATTERING_GROUP_SPREAD times its
+// group's smallest; the group's samples are spaced for the geometric mean of its extremes.
+int singleScatteringGroups(vec3 extinction, out int group[3], out float reference[3]) {
+  int order[3] = int[3](0, 1, 2);
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2 - a; ++b)
+      if (extinction[order[b + 1]] < extinction[order[b]]) {
+        const int t = order[b];
+        order[b] = order[b + 1];
+        order[b + 1] = t;
+      }
+  int groups = 0;
+  float low = 0.0, high = 0.0;
+  reference = float[3](0.0, 0.0, 0.0);
+  group = int[3](-1, -1, -1);
+  for (int k = 0; k < 3; ++k) {
+    const int ch = order[k];
+    const float sigma = extinction[ch];
+    if (!(sigma > 0.0)) continue;
+    if (groups == 0 || sigma > float(SSLPV_SINGLE_SCATTERING_GROUP_SPREAD) * low) {
+      low = sigma;
+      ++groups;
+    }
+    high = sigma;
+    group[ch] = groups - 1;
+    reference[groups - 1] = sqrt(low * high);
+  }
+  return groups;
+}
+
 // Twin of singleScatteredRadiance (volume/single_scattering.cpp).
 vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
   const float cellSize = grid.cellSize;
   vec3 extinction0, scattering0;
   if (!reducedMediumAt(grid, p + 0.5 * cellSize * inward, extinction0, scattering0)) return vec3(0.0);
+  int group[3];
+  float reference[3];
+  const int groups = singleScatteringGroups(extinction0, group, reference);
   const uint views = uint(push.gridDims.w);
-  vec3 result = vec3(0.0);
-  for (int ch = 0; ch < 3; ++ch) {
-    const float sigma0 = extinction0[ch];
-    if (!(sigma0 > 0.0)) continue;
-    float sum = 0.0, opticalDepth = 0.0, lastS = 0.0, lastSigma = sigma0;
+  vec3 sum = vec3(0.0);
+  for (int gi = 0; gi < groups; ++gi) {
+    const float sigma0 = reference[gi];
+    vec3 opticalDepth = vec3(0.0), lastSigma = extinction0;
+    float lastS = 0.0;
     for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
       const float u = (float(k) + 0.5) / float(SSLPV_SINGLE_SCATTERING_SAMPLES);
       const float s = -log(1.0 - u) / sigma0;
       const vec3 q = p + s * into;
       vec3 extinction, scattering;
       if (!reducedMediumAt(grid, q, extinction, scattering)) break;
-      const float sigma = extinction[ch];
-      opticalDepth += 0.5 * (sigma + lastSigma) * (s - lastS);
+      opticalDepth += 0.5 * (extinction + lastSigma) * (s - lastS);
       lastS = s;
-      lastSigma = sigma;
-      float arriving = 0.0;
+      lastSigma = extinction;
+      vec3 arriving = vec3(0.0);
       uint lastLight = 0xffffffffu;
       for (uint v = 0u; v < views; ++v) {
         if (shadowViews[v].texels.z == lastLight) continue;  // a cube map's other faces
@@ -158,7 +191,7 @@ vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
         float distance, pathScale;
         entryOf(v, record, irradiance, distance, pathScale);
         const float below = along - distance;
-        if (irradiance[ch] == 0.0 || below < -cellSize) continue;
+        if (irradiance == vec3(0.0) || below < -cellSize) continue;
         const float path = max(0.0, below) * pathScale;
         // Where the planar estimate's entry point is not on the surface the light's map
         // sees, q gets none of this light (singleScatteredRadiance).
@@ -167,16 +200,17 @@ vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
         const int entry = texelThrough(v, start, startAlong);
         if (entry < 0) continue;
         const GpuFluxSample entered = shadowSamples[entry];
-        if (entered.positionValid.w == 0.0 || entered.flux.rgb == vec3(0.0) ||
-            length(start - entered.positionValid.xyz) > max(1.5 * cellSize, 0.5 * below))
-          continue;
-        arriving += irradiance[ch] * exp(-sigma * path);
+        if (entered.positionValid.w == 0.0 || entered.flux.rgb == vec3(0.0)) continue;
+        const float tolerance = max(1.5 * cellSize, 0.5 * below);
+        const float onSurface = clamp(2.0 - length(start - entered.positionValid.xyz) / tolerance, 0.0, 1.0);
+        for (int ch = 0; ch < 3; ++ch)
+          if (group[ch] == gi) arriving[ch] += onSurface * irradiance[ch] * exp(-extinction[ch] * path);
       }
-      sum += scattering[ch] / sigma0 * exp(sigma0 * s - opticalDepth) * arriving;
+      for (int ch = 0; ch < 3; ++ch)
+        if (group[ch] == gi) sum[ch] += scattering[ch] / sigma0 * exp(sigma0 * s - opticalDepth[ch]) * arriving[ch];
     }
-    result[ch] = sum / (float(SSLPV_SINGLE_SCATTERING_SAMPLES) * 4.0 * float(SSLPV_PI));
   }
-  return result;
+  return sum / (float(SSLPV_SINGLE_SCATTERING_SAMPLES) * 4.0 * float(SSLPV_PI));
 }
 
 void main() {

@@ -67,5 +67,7 @@
 // The calibrated shading's single-scattering term (volume/single_scattering.h): samples
 // per channel along the refracted view ray, midpoints in u = 1 - exp(-sigma_t' s).
 #define SSLPV_SINGLE_SCATTERING_SAMPLES 8
+// Channels whose sigma_t' lie within this factor of their group's smallest share samples.
+#define SSLPV_SINGLE_SCATTERING_GROUP_SPREAD 1.5
 
 #endif

@@ -1,5 +1,6 @@
 #include "volume/single_scattering.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 
@@ -56,27 +57,54 @@ const EntryTexel* texelThrough(const EntryMap& map, const glm::dvec3& q, double&
 
 }  // namespace
 
+int singleScatteringGroups(const glm::dvec3& extinction, int group[3], double reference[3]) {
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int a, int b) { return extinction[a] < extinction[b]; });
+  int groups = 0;
+  double low = 0.0, high = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const int ch = order[k];
+    const double sigma = extinction[ch];
+    if (!(sigma > 0.0)) {
+      group[ch] = -1;  // no medium: nothing scatters
+      continue;
+    }
+    if (groups == 0 || sigma > SSLPV_SINGLE_SCATTERING_GROUP_SPREAD * low) {
+      low = sigma;
+      ++groups;
+    }
+    high = sigma;
+    group[ch] = groups - 1;
+    reference[groups - 1] = std::sqrt(low * high);
+  }
+  return groups;
+}
+
 glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
                                   const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into) {
   const double cellSize = material.frame.cellSize;
   ReducedMedium surface;
   if (!reducedMediumAt(material, p + 0.5 * cellSize * inward, surface)) return glm::vec3(0.0f);
-  glm::vec3 radiance(0.0f);
-  for (int ch = 0; ch < 3; ++ch) {
-    const double sigma0 = surface.extinction[ch];
-    if (!(sigma0 > 0.0)) continue;
-    double sum = 0.0, opticalDepth = 0.0, lastS = 0.0, lastSigma = sigma0;
+  // Channels whose σt' are close share their samples (spaced for the group's reference
+  // σ): one medium and one shadow-map lookup serve them all.
+  int group[3];
+  double reference[3];
+  const int groups = singleScatteringGroups(surface.extinction, group, reference);
+  glm::dvec3 sum(0.0);
+  for (int gi = 0; gi < groups; ++gi) {
+    const double sigma0 = reference[gi];
+    glm::dvec3 opticalDepth(0.0), lastSigma = surface.extinction;
+    double lastS = 0.0;
     for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
       const double u = (k + 0.5) / SSLPV_SINGLE_SCATTERING_SAMPLES;
       const double s = -std::log1p(-u) / sigma0;
       const glm::dvec3 q = p + s * into;
       ReducedMedium medium;
       if (!reducedMediumAt(material, q, medium)) break;
-      const double sigma = medium.extinction[ch];
-      opticalDepth += 0.5 * (sigma + lastSigma) * (s - lastS);
+      opticalDepth += 0.5 * (medium.extinction + lastSigma) * (s - lastS);
       lastS = s;
-      lastSigma = sigma;
-      double arriving = 0.0;
+      lastSigma = medium.extinction;
+      glm::dvec3 arriving(0.0);
       int lastLight = -1;
       for (const EntryMap& map : maps) {
         if (map.light == lastLight) continue;  // a cube map's other faces
@@ -84,7 +112,7 @@ glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vecto
         const EntryTexel* texel = texelThrough(map, q, along);
         if (texel == nullptr) continue;
         lastLight = map.light;
-        if (texel->irradiance[ch] == 0.0f) continue;
+        if (texel->irradiance == glm::vec3(0.0f)) continue;
         // q can sit up to a texel in front of its entry point; light that would reach q
         // from in front of the surface by more than a cell went round the object.
         const double below = along - double(texel->distance);
@@ -93,21 +121,27 @@ glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vecto
         // The planar estimate puts the entry of the beam that reaches q at q − path·d_t.
         // Where the surface curves away from the entry's tangent plane (past the light's
         // terminator, behind a grazing entry) that point is not where light enters: the
-        // light's own map sees its surface elsewhere, and q gets none of this light.
+        // light's own map sees its surface elsewhere, and q gets none of this light. The
+        // cut is a ramp (full up to the tolerance, none beyond twice it), so that a texel
+        // boundary or a rounding cannot switch a sample's light on or off.
         double entryAlong = 0.0;
         const glm::dvec3 start = q - path * glm::dvec3(texel->direction);
         const EntryTexel* entry = texelThrough(map, start, entryAlong);
-        if (entry == nullptr || entry->irradiance == glm::vec3(0.0f) ||
-            glm::length(start - glm::dvec3(entry->position)) > std::max(1.5 * cellSize, 0.5 * below))
-          continue;
-        arriving += texel->irradiance[ch] * std::exp(-sigma * path);
+        if (entry == nullptr || entry->irradiance == glm::vec3(0.0f)) continue;
+        const double tolerance = std::max(1.5 * cellSize, 0.5 * below);
+        const double onSurface =
+            std::clamp(2.0 - glm::length(start - glm::dvec3(entry->position)) / tolerance, 0.0, 1.0);
+        for (int ch = 0; ch < 3; ++ch)
+          if (group[ch] == gi)
+            arriving[ch] += onSurface * texel->irradiance[ch] * std::exp(-medium.extinction[ch] * path);
       }
       // ∫ σs' e^{-τ} f ds in the variable u: ds = du / (σ0 (1 − u)), and 1 − u = e^{-σ0 s}.
-      sum += medium.scattering[ch] / sigma0 * std::exp(sigma0 * s - opticalDepth) * arriving;
+      for (int ch = 0; ch < 3; ++ch)
+        if (group[ch] == gi)
+          sum[ch] += medium.scattering[ch] / sigma0 * std::exp(sigma0 * s - opticalDepth[ch]) * arriving[ch];
     }
-    radiance[ch] = float(sum / (SSLPV_SINGLE_SCATTERING_SAMPLES * 4.0 * SSLPV_PI));
   }
-  return radiance;
+  return glm::vec3(sum / (SSLPV_SINGLE_SCATTERING_SAMPLES * 4.0 * SSLPV_PI));
 }
 
 }  // namespace sslpv
