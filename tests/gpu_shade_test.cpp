@@ -126,6 +126,15 @@ double distanceToEdges(const TriangleMesh& mesh, unsigned triangle, const glm::d
 
 constexpr int kSingleScatteringMap = 128;
 
+/// The CPU shadow maps' texels of `lights` for the single-scattering term.
+std::vector<EntryMap> cpuEntryMaps(const std::vector<Light>& lights, const RayScene& rays, const Bounds& bounds,
+                                   double ior) {
+  std::vector<EntryMap> entries;
+  for (std::size_t l = 0; l < lights.size(); ++l)
+    castShadowMap(lights[l], rays, bounds, kSingleScatteringMap, ior, nullptr, &entries, int(l));
+  return entries;
+}
+
 class GpuShadeTest : public GpuTest {
  protected:
   /// Shades `o` from `camera` with both backends and checks the expectations above.
@@ -134,10 +143,8 @@ class GpuShadeTest : public GpuTest {
   void compareWithCpu(const LitObject& o, const Camera& camera, double ior, const std::string& what,
                       const std::vector<Light>* singleLights = nullptr) {
     RayScene rays(o.mesh);
-    std::vector<EntryMap> entries;
-    if (singleLights)
-      for (std::size_t l = 0; l < singleLights->size(); ++l)
-        castShadowMap((*singleLights)[l], rays, o.mesh.bounds(), kSingleScatteringMap, ior, nullptr, &entries, int(l));
+    const std::vector<EntryMap> entries =
+        singleLights ? cpuEntryMaps(*singleLights, rays, o.mesh.bounds(), ior) : std::vector<EntryMap>{};
     const Image cpu = shadeImage(camera, rays, o.material, o.accumulated, ior, &o.factors.exitGain,
                                  &o.factors.reducedAlbedo, singleLights ? &entries : nullptr);
     gpu::GpuMesh mesh(device(), o.mesh);
@@ -314,9 +321,7 @@ TEST_F(GpuShadeTest, SingleScatteringMatchesTheCpuTerm) {
   const Camera camera = cameraAt({2.2, 1.8, 3.4}, {0.1, 0.15, 0.0}, 256, 256);
   // The term must matter, or the comparison says nothing about it.
   RayScene rays(o.mesh);
-  std::vector<EntryMap> entries;
-  for (std::size_t l = 0; l < lights.size(); ++l)
-    castShadowMap(lights[l], rays, o.mesh.bounds(), kSingleScatteringMap, 1.3, nullptr, &entries, int(l));
+  const std::vector<EntryMap> entries = cpuEntryMaps(lights, rays, o.mesh.bounds(), 1.3);
   const Image with = shadeImage(camera, rays, o.material, o.accumulated, 1.3, &o.factors.exitGain,
                                 &o.factors.reducedAlbedo, &entries);
   const Image without =

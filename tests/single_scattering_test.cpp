@@ -110,7 +110,6 @@ LitSlab litSlab(float irradiance) {
       t.distance = 10.0f;
       t.pathScale = 1.0f;
       t.irradiance = glm::vec3(irradiance, 2.0f * irradiance, 0.5f * irradiance);
-      t.normal = glm::vec3(0.0f, 1.0f, 0.0f);
       t.direction = glm::vec3(0.0f, -1.0f, 0.0f);
     }
   slab.maps.push_back(map);

@@ -94,6 +94,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::ShadowMap)) {
     samples_.clear();
+    // Kept whatever the scheme: switching to the calibrated one does not re-cast the maps.
     entries_.clear();
     report.lights.clear();
     for (std::size_t l = 0; l < scene_.lights.size(); ++l) {

@@ -1,8 +1,6 @@
 // The calibrated exit law's table; the model and its reasons are in exit_law.h.
 #include "volume/exit_law.h"
 
-#include "volume/lpv_calibration.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>

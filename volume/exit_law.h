@@ -11,7 +11,8 @@
 //
 // The law: outside radiance = T(μo)/η² · h(μo; α', η) · L_in, with h the radiance of the
 // adding-doubling half-space (normal incidence) just below the boundary along the
-// direction that refracts into μo, normalised so that
+// direction that refracts into μo, less its once-scattered part α'(1 − F(0))/(4π(1 + μ))
+// (the shading adds that light itself, volume/single_scattering.h), normalised so that
 //    2 ∫0^1 T(μo)/η² h(μo) μo dμo = 2 ∫0^1 T(μo)/η² μo dμo = diffuseBoundaryTransmittance(η):
 // the total exitant power of every cell is exactly what the Lambertian law gave, so the
 // exit gain (calibrated against that power) and its tests hold unchanged. h = 1 is the

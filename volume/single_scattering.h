@@ -37,7 +37,6 @@ struct EntryTexel {
   float pathScale = 0.0f;     ///< cos θi / cos θt: refracted path per straight distance below the surface
   glm::vec3 irradiance{0.0f}; ///< E T(θi) cos θi / cos θt per channel; 0 for a miss or no light
   float distance = 0.0f;      ///< of the hit along the texel ray (orthographic: from its start plane)
-  glm::vec3 normal{0.0f};     ///< outward unit normal at the entry point
   glm::vec3 direction{0.0f};  ///< unit refracted direction of the light inside
 };
 
