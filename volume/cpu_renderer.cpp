@@ -94,12 +94,13 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::ShadowMap)) {
     samples_.clear();
-    // Kept whatever the scheme: switching to the calibrated one does not re-cast the maps.
     entries_.clear();
     report.lights.clear();
     for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
       const Light& light = scene_.lights[l];
       ShadowMapStats stats;
+      // The entry maps are filled whatever the scheme, so that switching to the calibrated
+      // one (the only reader) does not re-cast the maps.
       auto lightSamples = castShadowMap(light, *rays_, object_.bounds(), settings.shadowMap, scene_.material.ior,
                                         &stats, &entries_, int(l));
       samples_.insert(samples_.end(), lightSamples.begin(), lightSamples.end());
