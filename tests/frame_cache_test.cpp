@@ -169,6 +169,16 @@ TEST(CpuFrameCache, BrushStrokeResamplesOnlyItsRegionAndMatchesAFullResample) {
   std::size_t changed = 0;
   for (std::size_t i = 0; i < after.pixels.size(); ++i) changed += after.pixels[i] != before.pixels[i];
   EXPECT_GT(changed, 0u) << "the stroke must be visible, or the test checks nothing";
+
+  // The stroke's frame kept the single-scattering term of the pixels that read no
+  // painted cell; a camera move afterwards must not reuse any of it.
+  scene.camera.position = glm::dvec3(40.0, 30.0, 70.0);
+  renderer.setCamera(scene.camera);
+  fresh.setCamera(scene.camera);
+  CpuRenderer freshMoved(scene);
+  freshMoved.setMaterialSet(stroke.set, std::nullopt);
+  const Image moved = renderer.render(scene.lpv);
+  expectSameImage(moved, freshMoved.render(scene.lpv));
 }
 
 }  // namespace

@@ -209,5 +209,45 @@ TEST(SingleScatteredRadiance, NoLightWhereThePlanarEntryIsNotOnTheSurface) {
   for (int ch = 0; ch < 3; ++ch) EXPECT_LT(grazing[ch], 0.02 * planar[ch]) << "channel " << ch;
 }
 
+TEST(SingleScatteringReads, EveryTermThatChangesWithAnEditedCellIsFlagged) {
+  // The renderer re-integrates after a material edit only the pixels whose term reads an
+  // edited cell. Over random view points and directions on the lit top face, with a
+  // block of cells darkened 2 below it: every term that changed must be flagged, some
+  // terms must change and some must be left alone (or the check would prove nothing).
+  const LitSlab before = litSlab(1.0f);
+  LitSlab after = before;
+  const GridFrame& frame = after.material.frame;
+  const glm::ivec3 centre = glm::ivec3(frame.toGrid(glm::dvec3(1.0, -2.0, 0.5)));
+  CellRange edited;
+  edited.lo = centre - 1;
+  edited.hi = centre + 1;
+  for (int z = edited.lo.z; z <= edited.hi.z; ++z)
+    for (int y = edited.lo.y; y <= edited.hi.y; ++y)
+      for (int x = edited.lo.x; x <= edited.hi.x; ++x) after.material.sigmaT[frame.index(x, y, z)] *= 3.0f;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> across(-6.0, 6.0), unit(0.0, 1.0);
+  const glm::dvec3 inward(0.0, -1.0, 0.0);
+  int changed = 0, flagged = 0, unflagged = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const glm::dvec3 p(across(rng), 0.0, across(rng));
+    const double mu = 0.2 + 0.8 * unit(rng), phi = 2.0 * SSLPV_PI * unit(rng), sine = std::sqrt(1.0 - mu * mu);
+    const glm::dvec3 into(sine * std::cos(phi), -mu, sine * std::sin(phi));
+    double reach = 0.0;
+    const glm::vec3 old = singleScatteredRadiance(before.material, before.maps, p, inward, into, &reach);
+    const glm::vec3 now = singleScatteredRadiance(after.material, after.maps, p, inward, into);
+    const bool reads = singleScatteringReads(frame, p, inward, into, reach, edited);
+    (reads ? flagged : unflagged) += 1;
+    if (now != old) {
+      ++changed;
+      EXPECT_TRUE(reads) << "an unflagged term changed at p " << p.x << " " << p.z << ", mu " << mu;
+    }
+  }
+  EXPECT_GT(changed, 20);
+  EXPECT_GT(unflagged, 2000) << "most terms read none of a 3-cell block";
+  EXPECT_GE(flagged, changed);
+  EXPECT_FALSE(singleScatteringReads(frame, glm::dvec3(0.0), inward, inward, 10.0, CellRange{}))
+      << "an empty range is read by nothing";
+}
+
 }  // namespace
 }  // namespace sslpv

@@ -3,6 +3,7 @@
 #include "volume/lpv_calibration.h"
 
 #include <chrono>
+#include <glm/common.hpp>
 
 #include "volume/error.h"
 #include "volume/material_set.h"
@@ -41,6 +42,38 @@ CpuRenderer::~CpuRenderer() = default;
 void CpuRenderer::setCamera(const Camera& camera) {
   scene_.camera = camera;
   dirty_.cameraChanged();
+  termCache_.valid = false;
+}
+
+CellRange CpuRenderer::changedSinceTerm() {
+  const std::size_t count = material_.sigmaT.size();
+  CellRange changed;
+  if (termSigmaT_.size() != count) {
+    // No copy of this grid yet: everything counts as changed.
+    changed.lo = glm::ivec3(0);
+    changed.hi = material_.frame.dims - 1;
+    termSigmaT_ = material_.sigmaT;
+    termSigmaS_ = material_.sigmaS;
+    termG_ = material_.g;
+    return changed;
+  }
+  const glm::ivec3 dims = material_.frame.dims;
+  changed.lo = dims;
+  changed.hi = glm::ivec3(-1);
+  for (int z = 0; z < dims.z; ++z)
+    for (int y = 0; y < dims.y; ++y)
+      for (int x = 0; x < dims.x; ++x) {
+        const std::size_t i = material_.frame.index(x, y, z);
+        if (material_.sigmaT[i] == termSigmaT_[i] && material_.sigmaS[i] == termSigmaS_[i] &&
+            material_.g[i] == termG_[i])
+          continue;
+        termSigmaT_[i] = material_.sigmaT[i];
+        termSigmaS_[i] = material_.sigmaS[i];
+        termG_[i] = material_.g[i];
+        changed.lo = glm::min(changed.lo, glm::ivec3(x, y, z));
+        changed.hi = glm::max(changed.hi, glm::ivec3(x, y, z));
+      }
+  return changed;
 }
 
 void CpuRenderer::setLights(const std::vector<Light>& lights) {
@@ -134,10 +167,17 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     report.times.markCached(Stage::Propagation);
   }
 
+  // The term reads the grid frame's medium and the shadow maps' texels: new ones of
+  // either (or a new camera, setCamera) leave nothing of it to reuse.
+  if (dirty_.dirty(Stage::Voxelize) || dirty_.dirty(Stage::ShadowMap)) termCache_.valid = false;
   if (dirty_.dirty(Stage::Shading)) {
+    const bool calibrated = factors_.scheme == LpvScheme::Calibrated;
+    CellRange changed;
+    // Compared even when the cache is cleared: that brings the copy up to date.
+    if (calibrated) changed = changedSinceTerm();
     image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
-                        &factors_.reducedAlbedo,
-                        factors_.scheme == LpvScheme::Calibrated ? &entries_ : nullptr);
+                        &factors_.reducedAlbedo, calibrated ? &entries_ : nullptr,
+                        calibrated ? &termCache_ : nullptr, &changed);
     report.times.shading = watch.lapMs();
   } else {
     report.times.markCached(Stage::Shading);

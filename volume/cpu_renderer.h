@@ -53,6 +53,13 @@ class CpuRenderer {
   StepFactors factors_;
   std::vector<SurfaceFluxSample> samples_;
   std::vector<EntryMap> entries_;  ///< the shadow maps' texels for the single-scattering term
+  /// The last calibrated frame's single-scattering term per pixel, and the medium it read
+  /// (the cells a material edit changed are found by comparing with it).
+  SingleScatteringCache termCache_;
+  std::vector<glm::vec3> termSigmaT_, termSigmaS_;
+  std::vector<float> termG_;
+  /// The cells whose medium differs from the one the cached term read; updates the copy.
+  CellRange changedSinceTerm();
   ShGrid injected_, accumulated_;
   RenderReport last_;
   Image image_;

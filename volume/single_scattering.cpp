@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
+#include <utility>
 
 #include "volume/lpv_constants.h"
 #include "volume/lpv_stages.h"
@@ -81,8 +83,10 @@ int singleScatteringGroups(const glm::dvec3& extinction, int group[3], double re
 }
 
 glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
-                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into) {
+                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into,
+                                  double* reach) {
   const double cellSize = material.frame.cellSize;
+  if (reach) *reach = 0.0;
   ReducedMedium surface;
   if (!reducedMediumAt(material, p + 0.5 * cellSize * inward, surface)) return glm::vec3(0.0f);
   // Channels whose σt' are close share their samples (spaced for the group's reference
@@ -99,6 +103,7 @@ glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vecto
       const double u = (k + 0.5) / SSLPV_SINGLE_SCATTERING_SAMPLES;
       const double s = -std::log1p(-u) / sigma0;
       const glm::dvec3 q = p + s * into;
+      if (reach) *reach = std::max(*reach, s);
       ReducedMedium medium;
       if (!reducedMediumAt(material, q, medium)) break;
       opticalDepth += 0.5 * (medium.extinction + lastSigma) * (s - lastS);
@@ -142,6 +147,33 @@ glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vecto
     }
   }
   return glm::vec3(sum / (SSLPV_SINGLE_SCATTERING_SAMPLES * 4.0 * SSLPV_PI));
+}
+
+bool singleScatteringReads(const GridFrame& frame, const glm::dvec3& p, const glm::dvec3& inward,
+                           const glm::dvec3& into, double reach, const CellRange& cells) {
+  if (cells.empty()) return false;
+  // activeTrilinearWeights reads cells floor(g) and floor(g) + 1, g = toGrid(q) − 0.5, so
+  // cell c is read from g in [c − 1, c + 1); a margin keeps rounding on the safe side.
+  constexpr double kMargin = 1e-3;
+  const glm::dvec3 lo = glm::dvec3(cells.lo) - 1.0 - kMargin, hi = glm::dvec3(cells.hi) + 1.0 + kMargin;
+  const auto grid = [&](const glm::dvec3& q) { return frame.toGrid(q) - 0.5; };
+  const glm::dvec3 surface = grid(p + 0.5 * frame.cellSize * inward);
+  if (glm::all(glm::greaterThanEqual(surface, lo)) && glm::all(glm::lessThanEqual(surface, hi))) return true;
+  // The segment against the box, slab by slab.
+  const glm::dvec3 a = grid(p), d = grid(p + reach * into) - a;
+  double t0 = 0.0, t1 = 1.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(d[axis]) < 1e-12) {
+      if (a[axis] < lo[axis] || a[axis] > hi[axis]) return false;
+      continue;
+    }
+    double enter = (lo[axis] - a[axis]) / d[axis], leave = (hi[axis] - a[axis]) / d[axis];
+    if (enter > leave) std::swap(enter, leave);
+    t0 = std::max(t0, enter);
+    t1 = std::min(t1, leave);
+    if (t0 > t1) return false;
+  }
+  return true;
 }
 
 }  // namespace sslpv

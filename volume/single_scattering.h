@@ -56,8 +56,32 @@ struct EntryMap {
 int singleScatteringGroups(const glm::dvec3& extinction, int group[3], double reference[3]);
 
 /// L(p, −t) above, per channel, inside the boundary: `into` is the refracted view
-/// direction (unit, into the medium), `inward` the inward unit normal at p.
+/// direction (unit, into the medium), `inward` the inward unit normal at p. `reach`, when
+/// given, receives the farthest sample distance along `into` that was looked up.
 glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
-                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into);
+                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into,
+                                  double* reach = nullptr);
+
+/// Cells lo..hi (inclusive per axis) whose medium changed; empty when lo > hi.
+struct CellRange {
+  glm::ivec3 lo{0}, hi{-1};
+  bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
+};
+
+/// Whether singleScatteredRadiance at (p, inward, into) with that `reach` can read a cell
+/// of `cells`: its surface lookup or a sample point along [p, p + reach·into] has one
+/// among its trilinear corners. Conservative: true may be a miss, false never is.
+bool singleScatteringReads(const GridFrame& frame, const glm::dvec3& p, const glm::dvec3& inward,
+                           const glm::dvec3& into, double reach, const CellRange& cells);
+
+/// The term of every pixel of the last frame, for shadeImage. Why: the term is most of a
+/// frame's shading, and a brush stroke changes the medium of a few cells, so re-shading
+/// after a stroke integrates again only the pixels whose samples read them. It holds for
+/// one camera, one set of shadow maps and one grid frame; whoever changes those clears it.
+struct SingleScatteringCache {
+  bool valid = false;
+  std::vector<glm::vec3> term;  ///< per pixel, the radiance the term adds (outside)
+  std::vector<float> reach;     ///< per pixel, singleScatteredRadiance's reach
+};
 
 }  // namespace sslpv
