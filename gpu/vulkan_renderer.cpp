@@ -69,7 +69,7 @@ void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& repo
 void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report) {
   const auto start = std::chrono::steady_clock::now();
   if (dirty_.resampleRegion() && propagator_) {
-    report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion());
+    report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion()).count();
   } else {
     resampleMaterial(object_.field(), material_);
     report.resampledCells = material_.frame.cellCount();

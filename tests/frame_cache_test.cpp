@@ -174,7 +174,6 @@ TEST(CpuFrameCache, BrushStrokeResamplesOnlyItsRegionAndMatchesAFullResample) {
   // painted cell; a camera move afterwards must not reuse any of it.
   scene.camera.position = glm::dvec3(40.0, 30.0, 70.0);
   renderer.setCamera(scene.camera);
-  fresh.setCamera(scene.camera);
   CpuRenderer freshMoved(scene);
   freshMoved.setMaterialSet(stroke.set, std::nullopt);
   const Image moved = renderer.render(scene.lpv);

@@ -3,7 +3,6 @@
 #include "volume/lpv_calibration.h"
 
 #include <chrono>
-#include <glm/common.hpp>
 
 #include "volume/error.h"
 #include "volume/material_set.h"
@@ -45,36 +44,6 @@ void CpuRenderer::setCamera(const Camera& camera) {
   termCache_.valid = false;
 }
 
-CellRange CpuRenderer::changedSinceTerm() {
-  const std::size_t count = material_.sigmaT.size();
-  CellRange changed;
-  if (termSigmaT_.size() != count) {
-    // No copy of this grid yet: everything counts as changed.
-    changed.lo = glm::ivec3(0);
-    changed.hi = material_.frame.dims - 1;
-    termSigmaT_ = material_.sigmaT;
-    termSigmaS_ = material_.sigmaS;
-    termG_ = material_.g;
-    return changed;
-  }
-  const glm::ivec3 dims = material_.frame.dims;
-  changed.lo = dims;
-  changed.hi = glm::ivec3(-1);
-  for (int z = 0; z < dims.z; ++z)
-    for (int y = 0; y < dims.y; ++y)
-      for (int x = 0; x < dims.x; ++x) {
-        const std::size_t i = material_.frame.index(x, y, z);
-        if (material_.sigmaT[i] == termSigmaT_[i] && material_.sigmaS[i] == termSigmaS_[i] &&
-            material_.g[i] == termG_[i])
-          continue;
-        termSigmaT_[i] = material_.sigmaT[i];
-        termSigmaS_[i] = material_.sigmaS[i];
-        termG_[i] = material_.g[i];
-        changed.lo = glm::min(changed.lo, glm::ivec3(x, y, z));
-        changed.hi = glm::max(changed.hi, glm::ivec3(x, y, z));
-      }
-  return changed;
-}
 
 void CpuRenderer::setLights(const std::vector<Light>& lights) {
   scene_.lights = lights;
@@ -112,10 +81,13 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::Resample)) {
     if (dirty_.resampleRegion()) {
-      report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion());
+      const CellRange cells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion());
+      resampledSinceTerm_.include(cells);
+      report.resampledCells = cells.count();
     } else {
       resampleMaterial(object_.field(), material_);
       report.resampledCells = material_.frame.cellCount();
+      termCache_.valid = false;
     }
     factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
     report.activeCells = 0;
@@ -167,17 +139,16 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     report.times.markCached(Stage::Propagation);
   }
 
-  // The term reads the grid frame's medium and the shadow maps' texels: new ones of
-  // either (or a new camera, setCamera) leave nothing of it to reuse.
+  // The term reads the medium and the shadow maps' texels: a new grid, a whole new medium
+  // (above), new maps or a new camera (setCamera) leave nothing of it to reuse.
   if (dirty_.dirty(Stage::Voxelize) || dirty_.dirty(Stage::ShadowMap)) termCache_.valid = false;
   if (dirty_.dirty(Stage::Shading)) {
     const bool calibrated = factors_.scheme == LpvScheme::Calibrated;
-    CellRange changed;
-    // Compared even when the cache is cleared: that brings the copy up to date.
-    if (calibrated) changed = changedSinceTerm();
     image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
                         &factors_.reducedAlbedo, calibrated ? &entries_ : nullptr,
-                        calibrated ? &termCache_ : nullptr, &changed);
+                        calibrated ? &termCache_ : nullptr, &resampledSinceTerm_);
+    // Seed frames leave the range growing: their shading reads no term.
+    if (calibrated) resampledSinceTerm_ = CellRange{};
     report.times.shading = watch.lapMs();
   } else {
     report.times.markCached(Stage::Shading);

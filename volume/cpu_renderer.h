@@ -53,13 +53,10 @@ class CpuRenderer {
   StepFactors factors_;
   std::vector<SurfaceFluxSample> samples_;
   std::vector<EntryMap> entries_;  ///< the shadow maps' texels for the single-scattering term
-  /// The last calibrated frame's single-scattering term per pixel, and the medium it read
-  /// (the cells a material edit changed are found by comparing with it).
+  /// The last calibrated frame's single-scattering term per pixel, and the cells
+  /// resampled since then (their medium may differ from what the cached terms read).
   SingleScatteringCache termCache_;
-  std::vector<glm::vec3> termSigmaT_, termSigmaS_;
-  std::vector<float> termG_;
-  /// The cells whose medium differs from the one the cached term read; updates the copy.
-  CellRange changedSinceTerm();
+  CellRange resampledSinceTerm_;
   ShGrid injected_, accumulated_;
   RenderReport last_;
   Image image_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/common.hpp>
 #include <string>
 #include <unistd.h>
 
@@ -19,6 +20,30 @@ std::size_t physicalMemoryBytes() {
   return std::size_t(pages) * std::size_t(pageSize);
 }
 }  // namespace
+
+void CellRange::include(const CellRange& other) {
+  if (other.empty()) return;
+  if (empty()) {
+    *this = other;
+    return;
+  }
+  lo = glm::min(lo, other.lo);
+  hi = glm::max(hi, other.hi);
+}
+
+CellRange cellsOverlapping(const GridFrame& frame, const Bounds& world) {
+  CellRange cells;
+  if (world.empty()) return cells;
+  const glm::dvec3 gMin = frame.toGrid(world.min), gMax = frame.toGrid(world.max);
+  for (int a = 0; a < 3; ++a) {
+    const int lo = int(std::clamp(std::floor(gMin[a]), 0.0, double(frame.dims[a])));
+    const int end = int(std::clamp(std::floor(gMax[a]) + 1.0, 0.0, double(frame.dims[a])));
+    if (lo >= end) return CellRange{};
+    cells.lo[a] = lo;
+    cells.hi[a] = end - 1;
+  }
+  return cells;
+}
 
 GridFrame makeGridFrame(const Bounds& objectBounds, int resolution) {
   if (resolution < 2) throw InputError("LPV resolution must be at least 2, got " + std::to_string(resolution));

@@ -37,6 +37,20 @@ struct GridFrame {
   glm::dvec3 toGrid(const glm::dvec3& world) const { return (world - origin) / cellSize; }
 };
 
+/// Cells lo..hi of a frame, inclusive per axis; empty when lo > hi on any axis.
+struct CellRange {
+  glm::ivec3 lo{0}, hi{-1};
+  bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
+  std::size_t count() const {
+    return empty() ? 0 : std::size_t(hi.x - lo.x + 1) * std::size_t(hi.y - lo.y + 1) * std::size_t(hi.z - lo.z + 1);
+  }
+  /// Grows to the smallest range holding both.
+  void include(const CellRange& other);
+};
+
+/// The cells of `frame` whose box overlaps `world` (empty when none does).
+CellRange cellsOverlapping(const GridFrame& frame, const Bounds& world);
+
 /// Frame whose longest axis holds `resolution` cubic cells and that covers `bounds`
 /// plus a margin of one cell on every side (so boundary cells always have neighbours
 /// outside the object). Throws ResourceError when the grids would not fit in memory.

@@ -455,25 +455,17 @@ void resampleMaterial(const MaterialField& field, MaterialGrid& material) {
   resampleCells(field, material, glm::ivec3(0), material.frame.dims);
 }
 
-std::size_t resampleMaterialRegion(const MaterialField& field, MaterialGrid& material, const Bounds& worldRegion) {
+CellRange resampleMaterialRegion(const MaterialField& field, MaterialGrid& material, const Bounds& worldRegion) {
   const GridFrame& frame = material.frame;
   if (material.sigmaT.size() != frame.cellCount() || material.sigmaS.size() != frame.cellCount() ||
       material.g.size() != frame.cellCount()) {
     resampleMaterial(field, material);
-    return frame.cellCount();
+    return CellRange{glm::ivec3(0), frame.dims - 1};
   }
-  if (worldRegion.empty()) return 0;
   // Every cell whose box overlaps the region: its box average may have changed.
-  const glm::dvec3 gMin = frame.toGrid(worldRegion.min), gMax = frame.toGrid(worldRegion.max);
-  glm::ivec3 lo, hi;
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = int(std::clamp(std::floor(gMin[a]), 0.0, double(frame.dims[a])));
-    hi[a] = int(std::clamp(std::floor(gMax[a]) + 1.0, 0.0, double(frame.dims[a])));
-    if (lo[a] >= hi[a]) return 0;
-  }
-  resampleCells(field, material, lo, hi);
-  const glm::ivec3 size = hi - lo;
-  return std::size_t(size.x) * std::size_t(size.y) * std::size_t(size.z);
+  const CellRange cells = cellsOverlapping(frame, worldRegion);
+  if (!cells.empty()) resampleCells(field, material, cells.lo, cells.hi + 1);
+  return cells;
 }
 
 }  // namespace sslpv

@@ -10,14 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "volume/lpv_grid.h"
 #include "volume/material.h"
 #include "volume/mesh.h"
 
 namespace sslpv {
-
-struct GridFrame;
-struct MaterialGrid;
-struct Bounds;
 
 struct MaterialSet {
   openvdb::Vec3SGrid::Ptr sigmaT;  ///< required
@@ -118,8 +115,8 @@ class MaterialField {
 void resampleMaterial(const MaterialField& field, MaterialGrid& material);
 
 /// Re-resamples only the cells whose box overlaps `worldRegion` (a brush stroke's bounds)
-/// and returns how many cells that was; the whole grid when the material arrays are not
-/// yet sized to the frame. The result equals a full resampleMaterial() of the new field.
-std::size_t resampleMaterialRegion(const MaterialField& field, MaterialGrid& material, const Bounds& worldRegion);
+/// and returns them; the whole grid when the material arrays are not yet sized to the
+/// frame. The result equals a full resampleMaterial() of the new field.
+CellRange resampleMaterialRegion(const MaterialField& field, MaterialGrid& material, const Bounds& worldRegion);
 
 }  // namespace sslpv

@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
-#include <limits>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
@@ -95,8 +94,8 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
                          float(boundaryScale * transmittance);
               if (cache != nullptr) {
                 cache->term[pixel] = radiance;
-                // Rounded up, so that the stored reach still covers the last sample.
-                cache->reach[pixel] = std::nextafter(float(reach), std::numeric_limits<float>::infinity());
+                // singleScatteringReads' margin covers the float rounding.
+                cache->reach[pixel] = float(reach);
               }
             }
           }

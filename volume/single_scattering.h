@@ -62,12 +62,6 @@ glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vecto
                                   const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into,
                                   double* reach = nullptr);
 
-/// Cells lo..hi (inclusive per axis) whose medium changed; empty when lo > hi.
-struct CellRange {
-  glm::ivec3 lo{0}, hi{-1};
-  bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
-};
-
 /// Whether singleScatteredRadiance at (p, inward, into) with that `reach` can read a cell
 /// of `cells`: its surface lookup or a sample point along [p, p + reach·into] has one
 /// among its trilinear corners. Conservative: true may be a miss, false never is.
