@@ -1,12 +1,10 @@
 #include "volume/strict_json.h"
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <system_error>
 
 #include "volume/error.h"
+#include "volume/input_file.h"
 
 namespace sslpv {
 
@@ -66,21 +64,7 @@ std::string describeType(const json& value) {
 }
 
 std::string readInputFile(const fs::path& file, const char* what) {
-  auto cannotRead = [&](int error) {
-    return InputError(file.string() + ": cannot read " + what + " (" + std::strerror(error) + ")");
-  };
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) throw cannotRead(EISDIR);
-  std::FILE* stream = std::fopen(file.c_str(), "rb");
-  if (!stream) throw cannotRead(errno);
-  std::string text;
-  char buffer[65536];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, stream)) > 0) text.append(buffer, got);
-  const int readError = std::ferror(stream) ? errno : 0;
-  std::fclose(stream);
-  if (readError != 0) throw cannotRead(readError);
-  return text;
+  return readRegularFile(file, what, kMaxJsonInputBytes);
 }
 
 bool JsonPathTracker::operator()(int /*depth*/, json::parse_event_t event, json& parsed) {

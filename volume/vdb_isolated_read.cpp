@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "volume/error.h"
+#include "volume/input_file.h"
 #include "volume/material_set.h"
 
 namespace sslpv {
@@ -126,7 +127,8 @@ std::size_t readerMemoryBudget(std::size_t fileBytes) {
 /// of a multi-threaded parent has one thread, and OpenVDB's read/write paths used here
 /// are serial (grid statistics, which use TBB, are switched off).
 [[noreturn]] void runReaderChild(const std::string& bytes, int fd, std::size_t addressLimit) {
-  for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGPIPE}) ::signal(sig, SIG_DFL);
+  // SIGINT and SIGTERM too: the parent's handlers would remove the parent's temporaries.
+  for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGPIPE, SIGINT, SIGTERM, SIGHUP}) ::signal(sig, SIG_DFL);
   // glibc's "malloc(): corrupted ..." and OpenVDB's log (stdout or stderr) would reach
   // the user's terminal before the one-line error the parent reports; a flush of the
   // parent's inherited stdout buffer would duplicate its output.
@@ -269,6 +271,8 @@ VdbContents readVdbFileIsolated(const fs::path& file) {
   std::error_code ec;
   if (!fs::exists(file, ec)) throw InputError(name + ": no such file");
   if (fs::is_directory(file, ec)) throw InputError(name + ": is a directory, not a VDB file");
+  if (std::string why = whyNotRegularFile(file); !why.empty())
+    throw InputError(name + ": cannot read material set (" + why + ")");
 
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(name + ": cannot open: " + std::strerror(errno));
