@@ -30,7 +30,17 @@ int runPaint(const PaintArgs& args) {
   const Scene scene = loadScene(args.scene);
   // Parsed before the mesh and grids load, so a typo in the strokes fails fast.
   const std::vector<Stroke> strokes = loadStrokes(args.strokes);
-  BrushEngine engine(makePaintTarget(scene));
+  // The target's own refusals name a role ("material set: ...", "box: ..."), not the
+  // scene they come from.
+  auto engineFor = [&] {
+    try {
+      return BrushEngine(makePaintTarget(scene));
+    } catch (const InputError& e) {
+      if (std::string(e.what()).rfind(args.scene + ": ", 0) == 0) throw;
+      throw InputError(args.scene + ": " + e.what());
+    }
+  };
+  BrushEngine engine = engineFor();
 
   for (std::size_t i = 0; i < strokes.size(); ++i) {
     StrokeResult result;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "volume/error.h"
+#include "volume/input_ranges.h"
 #include "volume/strict_json.h"
 
 namespace sslpv {
@@ -46,20 +47,42 @@ class SceneReader : public StrictJsonReader {
  public:
   using StrictJsonReader::StrictJsonReader;
 
-  /// RGB radiometric quantities and coefficients: finite and non-negative.
-  glm::dvec3 nonNegativeRgb(const json& value, const std::string& path) const {
+  /// Finite is not enough (volume/input_ranges.h); the message names the range.
+  void requireRange(double value, const std::string& path, double lo, double hi) const {
+    if (!(value >= lo && value <= hi))
+      fail(path, "must be in [" + formatNumber(lo) + ", " + formatNumber(hi) + "], got " + formatNumber(value));
+  }
+
+  /// [x, y, z] with every element in [lo, hi] (a bad one named by its index).
+  glm::dvec3 boundedVec3(const json& value, const std::string& path, double lo, double hi) const {
+    const glm::dvec3 result = vec3(value, path);
+    for (int i = 0; i < 3; ++i) requireRange(result[i], indexPath(path, std::size_t(i)), lo, hi);
+    return result;
+  }
+
+  /// A point in scene units.
+  glm::dvec3 coordinate(const json& value, const std::string& path) const {
+    return boundedVec3(value, path, -kMaxCoordinate, kMaxCoordinate);
+  }
+
+  /// RGB radiometric quantities and coefficients: finite, non-negative, at most `max`.
+  glm::dvec3 nonNegativeRgb(const json& value, const std::string& path, double max) const {
     glm::dvec3 result = vec3(value, path, "non-negative numbers");
     for (int i = 0; i < 3; ++i) {
       if (result[i] < 0.0)
         fail(indexPath(path, i), "expected a non-negative number, got " + formatNumber(result[i]));
+      requireRange(result[i], indexPath(path, i), 0.0, max);
     }
     return result;
   }
 
   glm::dvec3 direction(const json& value, const std::string& path) const {
-    glm::dvec3 result = vec3(value, path);
+    glm::dvec3 result = boundedVec3(value, path, -kMaxDirectionComponent, kMaxDirectionComponent);
     double length = glm::length(result);
-    if (!(length > 0.0) || !std::isfinite(length)) fail(path, "expected a non-zero direction vector");
+    if (!(length > 0.0)) fail(path, "expected a non-zero direction vector");
+    if (!(length >= kMinDirectionLength))
+      fail(path, "expected a direction vector of length at least " + formatNumber(kMinDirectionLength) +
+                     ", got " + formatNumber(length));
     return result / length;
   }
 
@@ -75,6 +98,9 @@ class SceneReader : public StrictJsonReader {
   fs::path filePath(const json& value, const std::string& path) const {
     std::string text = string(value, path);
     if (text.empty()) fail(path, "expected a non-empty file path");
+    // The operating system ends a path at its first NUL: "a.obj\u0000x" would silently
+    // open a.obj.
+    if (text.find('\0') != std::string::npos) fail(path, "a file path must not contain a NUL character (\\u0000)");
     return (file().parent_path() / fs::path(text)).lexically_normal();
   }
 };
@@ -97,8 +123,8 @@ MeshSource parseMesh(const SceneReader& in, const json& node) {
   if (kind == "box") {
     in.allowOnly(node, path, {"primitive", "min", "max"});
     mesh.kind = MeshSource::Kind::Box;
-    mesh.boxMin = in.vec3(in.required(node, path, "min"), childPath(path, "min"));
-    mesh.boxMax = in.vec3(in.required(node, path, "max"), childPath(path, "max"));
+    mesh.boxMin = in.coordinate(in.required(node, path, "min"), childPath(path, "min"));
+    mesh.boxMax = in.coordinate(in.required(node, path, "max"), childPath(path, "max"));
     static const char* const kAxis[] = {"x", "y", "z"};
     for (int i = 0; i < 3; ++i) {
       if (!(mesh.boxMin[i] < mesh.boxMax[i]))
@@ -109,10 +135,11 @@ MeshSource parseMesh(const SceneReader& in, const json& node) {
   } else if (kind == "sphere") {
     in.allowOnly(node, path, {"primitive", "center", "radius"});
     mesh.kind = MeshSource::Kind::Sphere;
-    mesh.center = in.vec3(in.required(node, path, "center"), childPath(path, "center"));
+    mesh.center = in.coordinate(in.required(node, path, "center"), childPath(path, "center"));
     std::string radiusPath = childPath(path, "radius");
     mesh.radius = in.number(in.required(node, path, "radius"), radiusPath);
     if (!(mesh.radius > 0.0)) in.fail(radiusPath, "must be positive, got " + formatNumber(mesh.radius));
+    in.requireRange(mesh.radius, radiusPath, kMinPrimitiveSize, kMaxCoordinate);
   } else {
     in.fail(childPath(path, "primitive"),
             "unknown primitive \"" + printable(kind) + "\" (accepted: \"box\", \"sphere\")");
@@ -125,12 +152,14 @@ Transform parseTransform(const SceneReader& in, const json& node) {
   in.requireObject(node, path);
   in.allowOnly(node, path, {"translate", "rotate_deg", "scale"});
   Transform transform;
-  if (const json* v = in.optional(node, "translate")) transform.translate = in.vec3(*v, childPath(path, "translate"));
-  if (const json* v = in.optional(node, "rotate_deg")) transform.rotateDeg = in.vec3(*v, childPath(path, "rotate_deg"));
+  if (const json* v = in.optional(node, "translate")) transform.translate = in.coordinate(*v, childPath(path, "translate"));
+  if (const json* v = in.optional(node, "rotate_deg"))
+    transform.rotateDeg = in.boundedVec3(*v, childPath(path, "rotate_deg"), -kMaxRotationDeg, kMaxRotationDeg);
   if (const json* v = in.optional(node, "scale")) {
     std::string scalePath = childPath(path, "scale");
     transform.scale = in.number(*v, scalePath);
     if (!(transform.scale > 0.0)) in.fail(scalePath, "must be positive, got " + formatNumber(transform.scale));
+    in.requireRange(transform.scale, scalePath, kMinScale, kMaxScale);
   }
   return transform;
 }
@@ -164,8 +193,8 @@ MaterialSpec parseMaterial(const SceneReader& in, const json& node, double unitM
   } else {
     in.allowOnly(base, basePath, {"sigma_t", "sigma_s", "g", "preset"});
     std::string tPath = childPath(basePath, "sigma_t"), sPath = childPath(basePath, "sigma_s");
-    glm::dvec3 sigmaT = in.nonNegativeRgb(in.required(base, basePath, "sigma_t"), tPath);
-    glm::dvec3 sigmaS = in.nonNegativeRgb(in.required(base, basePath, "sigma_s"), sPath);
+    glm::dvec3 sigmaT = in.nonNegativeRgb(in.required(base, basePath, "sigma_t"), tPath, kMaxSigma);
+    glm::dvec3 sigmaS = in.nonNegativeRgb(in.required(base, basePath, "sigma_s"), sPath, kMaxSigma);
     for (int c = 0; c < 3; ++c) {
       if (sigmaS[c] > sigmaT[c])
         in.fail(indexPath(sPath, c), "exceeds sigma_t (" + formatNumber(sigmaS[c]) + " > " +
@@ -196,9 +225,9 @@ Light parseLight(const SceneReader& in, const json& node, const std::string& pat
   std::string typePath = childPath(path, "type");
   std::string type = in.string(in.required(node, path, "type"), typePath);
   auto rgb = [&](const char* key) {
-    return glm::vec3(in.nonNegativeRgb(in.required(node, path, key), childPath(path, key)));
+    return glm::vec3(in.nonNegativeRgb(in.required(node, path, key), childPath(path, key), kMaxRadiometric));
   };
-  auto vec = [&](const char* key) { return in.vec3(in.required(node, path, key), childPath(path, key)); };
+  auto vec = [&](const char* key) { return in.coordinate(in.required(node, path, key), childPath(path, key)); };
   auto dir = [&](const char* key) {
     return in.direction(in.required(node, path, key), childPath(path, key));
   };
@@ -231,8 +260,8 @@ Camera parseCamera(const SceneReader& in, const json& node) {
   in.requireObject(node, path);
   in.allowOnly(node, path, {"position", "target", "up", "fov_y_deg", "width", "height"});
   Camera camera;
-  camera.position = in.vec3(in.required(node, path, "position"), childPath(path, "position"));
-  camera.target = in.vec3(in.required(node, path, "target"), childPath(path, "target"));
+  camera.position = in.coordinate(in.required(node, path, "position"), childPath(path, "position"));
+  camera.target = in.coordinate(in.required(node, path, "target"), childPath(path, "target"));
   if (const json* v = in.optional(node, "up")) camera.up = in.direction(*v, childPath(path, "up"));
   camera.fovYDeg = in.openInterval(in.required(node, path, "fov_y_deg"), childPath(path, "fov_y_deg"), 0.0, 180.0);
   camera.width = in.integer(in.required(node, path, "width"), childPath(path, "width"), 1, kMaxImageSide);
@@ -241,6 +270,11 @@ Camera parseCamera(const SceneReader& in, const json& node) {
   glm::dvec3 view = camera.target - camera.position;
   double viewLength = glm::length(view);
   if (!(viewLength > 0.0)) in.fail(childPath(path, "target"), "equals camera.position: the view direction is undefined");
+  // Closer than float resolves at these coordinates, the view direction would be noise.
+  const double resolvable = kMinDirectionLength * std::max({1.0, glm::length(camera.position), glm::length(camera.target)});
+  if (!(viewLength >= resolvable))
+    in.fail(childPath(path, "target"), "is only " + formatNumber(viewLength) + " from camera.position (at least " +
+                                           formatNumber(resolvable) + " needed for a defined view direction)");
   // A nearly parallel up vector leaves the camera's roll undefined (and its basis noisy).
   if (glm::length(glm::cross(view / viewLength, camera.up)) < 1e-6)
     in.fail(childPath(path, "up"), "is parallel to the view direction (camera.target - camera.position)");

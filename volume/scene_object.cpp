@@ -12,8 +12,16 @@ SceneObject::SceneObject(const Scene& scene)
       unitInMm_(scene.unitInMm),
       worldToRest_(glm::inverse(scene.transform.matrix())) {
   const auto start = std::chrono::steady_clock::now();
-  mesh_ = loadMesh(scene.mesh, scene.transform);
-  requireClosedMesh(mesh_);
+  try {
+    mesh_ = loadMesh(scene.mesh, scene.transform);
+    requireClosedMesh(mesh_);
+  } catch (const InputError& e) {
+    // The mesh's own message names a primitive ("box") or the mesh file; which scene and
+    // key it came from is known only here.
+    if (scene.file.empty()) throw;
+    const char* key = scene.mesh.kind == MeshSource::Kind::File ? "mesh.path" : "mesh";
+    throw InputError(scene.file.string() + ": " + key + ": " + e.what());
+  }
   bounds_ = mesh_.bounds();
   setMaterialSet(scene.material.vdb ? loadMaterialSet(*scene.material.vdb) : nullptr);
   loadMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
