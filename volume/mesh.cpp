@@ -12,16 +12,21 @@
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 #include <limits>
+#include <sstream>
 #include <unordered_map>
 
 #include "volume/error.h"
+#include "volume/input_file.h"
+#include "volume/input_ranges.h"
 
 namespace sslpv {
 namespace {
@@ -31,6 +36,12 @@ namespace fs = std::filesystem;
 std::string formatPoint(const glm::dvec3& p) {
   char text[96];
   std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g)", p.x, p.y, p.z);
+  return text;
+}
+
+std::string coordinateRange() {
+  char text[64];
+  std::snprintf(text, sizeof text, "[%g, %g]", -kMaxCoordinate, kMaxCoordinate);
   return text;
 }
 
@@ -143,13 +154,41 @@ void weldExactDuplicates(TriangleMesh& mesh) {
   mesh.positions.swap(welded);
 }
 
+/// Assimp opens an OBJ's material libraries itself and does not stop at a FIFO or a
+/// device (it blocks in open()), so the `mtllib` files an OBJ names pass the mesh's own
+/// regular-file check first. A missing library stays assimp's business: it goes on
+/// without it, as for any OBJ whose .mtl was not copied along.
+void requireRegularMaterialLibraries(const fs::path& obj) {
+  std::ifstream in(obj, std::ios::binary);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string keyword;
+    if (!(words >> keyword) || keyword != "mtllib") continue;
+    // Assimp reads the rest of the line as one file name.
+    std::string name;
+    std::getline(words >> std::ws, name);
+    while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back()))) name.pop_back();
+    if (name.empty()) continue;
+    const fs::path library = obj.parent_path() / name;
+    std::error_code ec;
+    if (fs::exists(library, ec))
+      requireRegularFile(library, ("material library of " + obj.string()).c_str());
+  }
+}
+
 TriangleMesh loadMeshFile(const fs::path& path) {
   const std::string name = path.string();
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(name + ": mesh file not found");
   if (!fs::is_regular_file(path, ec)) throw InputError(name + ": mesh path is not a regular file");
+  requireRegularFile(path, "mesh file");  // a /proc file passes the test above
   if (!std::ifstream(path, std::ios::binary).good())
     throw InputError(name + ": cannot read mesh file (" + std::strerror(errno) + ")");
+
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".obj") requireRegularMaterialLibraries(path);
 
   Assimp::Importer importer;
   auto failure = [&] {
@@ -157,10 +196,12 @@ TriangleMesh loadMeshFile(const fs::path& path) {
     std::replace(reason.begin(), reason.end(), '\n', ' ');
     return InputError(name + ": cannot load mesh: " + (reason.empty() ? "unknown assimp error" : reason));
   };
+  // No aiProcess_JoinIdenticalVertices: it merges vertices closer than an absolute 1e-5,
+  // which folds a small (but valid) mesh into a non-manifold one; weldExactDuplicates
+  // joins only bit-identical positions, whatever the mesh's size.
   // Face indices are range-checked below rather than with aiProcess_ValidateDataStructure,
   // whose messages ("aiScene::mNumMeshes is 0") would only confuse a user.
-  const aiScene* scene =
-      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate);
   if (!scene) throw failure();
   bool anyFace = false;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m)
@@ -263,7 +304,14 @@ TriangleMesh loadMesh(const MeshSource& source, const Transform& transform) {
   if (!(transform.scale > 0.0) || !std::isfinite(transform.scale))
     throw InputError(mesh.name + ": transform scale must be positive, got " + std::to_string(transform.scale));
   const glm::dmat4 toWorld = transform.matrix();
-  for (auto& p : mesh.positions) p = glm::vec3(toWorld * glm::dvec4(glm::dvec3(p), 1.0));
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    const glm::dvec3 world(toWorld * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0));
+    // Checked in double, before float rounding could turn an overflow into Inf.
+    if (!(glm::all(glm::lessThanEqual(glm::abs(world), glm::dvec3(kMaxCoordinate)))))
+      throw InputError(mesh.name + ": vertex " + std::to_string(i) + " lies at " + formatPoint(world) +
+                       " after the transform, outside the coordinate range " + coordinateRange());
+    mesh.positions[i] = glm::vec3(world);
+  }
   return mesh;
 }
 
