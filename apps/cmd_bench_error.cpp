@@ -71,7 +71,7 @@ void writeText(const fs::path& file, const std::string& text) {
     std::ofstream out(temp, std::ios::binary);
     out << text;
     out.close();
-    if (!out) throw ResourceError(file.string() + ": write failed");
+    if (!out) throwWriteFailed(file, errno);
   });
 }
 

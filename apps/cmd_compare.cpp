@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -160,7 +161,7 @@ int runCompare(const CompareArgs& args) {
       std::ofstream out(temp, std::ios::binary);
       out << text;
       out.close();
-      if (!out) throw InputError(args.json + ": write failed");
+      if (!out) throwWriteFailed(args.json, errno);
     });
   }
   if (!args.ratioMap.empty())

@@ -28,9 +28,11 @@
 #include "volume/cpu_renderer.h"
 #include "volume/error.h"
 #include "volume/image_io.h"
+#include "volume/input_ranges.h"
 #include "volume/material_set.h"
 #include "volume/reference_tracer.h"
 #include "volume/scene.h"
+#include "volume/strict_json.h"
 
 namespace {
 
@@ -59,10 +61,13 @@ int runRender(const RenderArgs& args) {
   if (!isSupportedImageExtension(args.output))
     throw InputError(args.output + ": unsupported output format (use .png, .pfm or .exr)");
   requireWritableOutput(args.output);
+  // Checked before the render: a bad flag should not cost one.
+  if (!(args.exposure >= kMinExposure && args.exposure <= kMaxExposure))
+    throw InputError("--exposure: must be in [" + formatNumber(kMinExposure) + ", " + formatNumber(kMaxExposure) +
+                     "], got " + formatNumber(args.exposure));
 
   Scene scene = loadScene(args.scene);
   const LpvSettings settings = applyLpvFlags(scene.lpv, {args.grid, args.steps, args.shadowMap, args.scheme});
-  if (!(args.exposure > 0.0f)) throw InputError("--exposure: must be positive");
 
   RenderReport report;
   Image image;
@@ -131,8 +136,8 @@ int runReference(const ReferenceArgs& args) {
   };
   const ReferenceResult result = tracer.render(options);
   std::fprintf(stderr, "\n");
-  writeImage(result.radiance, args.output);
-  writeImage(result.standardError, errorFile);
+  // Together: a full disk must not leave a new image beside the old one's error image.
+  writeAtomicallyTogether({imageOutput(result.radiance, args.output), imageOutput(result.standardError, errorFile)});
   return 0;
 }
 
@@ -205,6 +210,18 @@ int main(int argc, char** argv) {
     return fail(kExitInput, std::string(e.what()) + " (see sslpv --help)");
   }
 
+  // A SIGINT or SIGTERM (Ctrl-C, a job scheduler's timeout) while an output is being
+  // written must not leave its temporary behind.
+  sslpv::removeTemporariesOnSignals();
+  // What an out-of-memory message names: the subcommand and its main input.
+  std::string activity = "sslpv";
+  for (const CLI::App* sub : app.get_subcommands()) {
+    activity = sub->get_name();
+    for (const CLI::Option* option : sub->get_options())
+      if (option->get_positional())
+        for (const std::string& value : option->results()) activity += " " + value;
+  }
+
   try {
     if (*renderCmd) return runRender(render);
     if (*referenceCmd) return runReference(reference);
@@ -224,7 +241,7 @@ int main(int argc, char** argv) {
   } catch (const sslpv::ResourceError& e) {
     return fail(kExitResource, e.what());
   } catch (const std::bad_alloc&) {
-    return fail(kExitResource, "out of memory");
+    return fail(kExitResource, activity + ": out of memory");
   } catch (const std::exception& e) {
     return fail(kExitInternal, std::string("internal error: ") + e.what());
   }

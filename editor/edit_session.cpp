@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <fstream>
 #include <glm/geometric.hpp>
@@ -41,7 +42,7 @@ void writeFile(const fs::path& file, const std::string& text, const fs::path& ta
   if (!out) throw InputError(target.string() + ": cannot write the file");
   out << text;
   out.flush();
-  if (!out) throw InputError(target.string() + ": cannot write the file (disk full?)");
+  if (!out) throwWriteFailed(target, errno);
 }
 
 bool hasVdbExtension(const fs::path& file) {

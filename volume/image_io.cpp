@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -103,7 +104,7 @@ void writePfm(const Image& image, const fs::path& path, const fs::path& target) 
     out.write(reinterpret_cast<const char*>(row.data()), std::streamsize(row.size() * 4));
   }
   out.close();
-  if (!out) throw InputError(target.string() + ": write failed");
+  if (!out) throwWriteFailed(target, errno);
 }
 
 std::string readWholeFile(const fs::path& file) {
@@ -217,7 +218,8 @@ void writeExr(const Image& image, const fs::path& path, const fs::path& target) 
     out.setFrameBuffer(frame);
     out.writePixels(image.height);
   } catch (const std::exception& e) {
-    throw InputError(target.string() + ": cannot write EXR: " + oneLine(e.what()));
+    // OpenEXR reports a full disk as an exception whose text carries the system's reason.
+    throw ResourceError(target.string() + ": write failed: " + oneLine(e.what()));
   }
 }
 
@@ -278,7 +280,7 @@ void writePng(const Image& image, const fs::path& path, const fs::path& target, 
   if (!out) throw InputError(target.string() + ": cannot open for writing");
   out.write(encoded.data(), std::streamsize(encoded.size()));
   out.close();
-  if (!out) throw InputError(target.string() + ": write failed");
+  if (!out) throwWriteFailed(target, errno);
 }
 
 Image readPng(const fs::path& file) {
@@ -313,7 +315,7 @@ bool isSupportedImageExtension(const fs::path& file) {
   return formatOf(file) != ImageFormat::Unknown;
 }
 
-void writeImage(const Image& image, const fs::path& file, float exposure) {
+AtomicOutput imageOutput(const Image& image, const fs::path& file, float exposure) {
   const ImageFormat format = formatOf(file);
   if (format == ImageFormat::Unknown) failUnknownExtension(file);
   if (image.width <= 0 || image.height <= 0 ||
@@ -321,14 +323,19 @@ void writeImage(const Image& image, const fs::path& file, float exposure) {
     throw std::invalid_argument("writeImage(" + file.string() + "): image is " +
                                 std::to_string(image.width) + "x" + std::to_string(image.height) +
                                 " with " + std::to_string(image.pixels.size()) + " pixels");
-  writeAtomically(file, [&](const fs::path& temp) {
-    switch (format) {
-      case ImageFormat::Png: writePng(image, temp, file, exposure); break;
-      case ImageFormat::Pfm: writePfm(image, temp, file); break;
-      case ImageFormat::Exr: writeExr(image, temp, file); break;
-      case ImageFormat::Unknown: break;
-    }
-  });
+  return {file, [&image, file, exposure, format](const fs::path& temp) {
+            switch (format) {
+              case ImageFormat::Png: writePng(image, temp, file, exposure); break;
+              case ImageFormat::Pfm: writePfm(image, temp, file); break;
+              case ImageFormat::Exr: writeExr(image, temp, file); break;
+              case ImageFormat::Unknown: break;
+            }
+          }};
+}
+
+void writeImage(const Image& image, const fs::path& file, float exposure) {
+  const AtomicOutput output = imageOutput(image, file, exposure);
+  writeAtomically(output.target, output.write);
 }
 
 Image readImage(const fs::path& file) {

@@ -5,6 +5,8 @@
 #include <glm/vec3.hpp>
 #include <vector>
 
+#include "volume/atomic_file.h"
+
 namespace sslpv {
 
 struct Image {
@@ -20,6 +22,10 @@ struct Image {
 /// Format chosen by extension (.png, .pfm, .exr; case-insensitive). InputError for any
 /// other extension or a missing/unwritable directory; the target is never half-written.
 void writeImage(const Image& image, const std::filesystem::path& file, float exposure = 1.0f);
+
+/// writeImage's checks and encoder as one file of writeAtomicallyTogether, for images
+/// that must be replaced together; `image` must outlive the result.
+AtomicOutput imageOutput(const Image& image, const std::filesystem::path& file, float exposure = 1.0f);
 
 /// The PNG writer's display encoding (exposure, clamp to [0, 1], sRGB, 8 bits), RGB
 /// interleaved, row 0 the top row: what a window shows of a rendered image.

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -296,7 +297,7 @@ PbrtExportSummary exportPbrtScene(const Scene& scene, const fs::path& output, in
     if (!out) throw InputError(output.string() + ": cannot open for writing");
     writePbrtScene(out, scene, object.mesh(), medium, image.string());
     out.close();
-    if (!out) throw ResourceError(output.string() + ": write failed (disk full or file too large?)");
+    if (!out) throwWriteFailed(output, errno);
   });
   PbrtExportSummary summary;
   summary.dims = medium.frame.dims;
