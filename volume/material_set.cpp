@@ -5,6 +5,7 @@
 #include <openvdb/io/File.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -154,6 +155,47 @@ void checkAlbedo(const openvdb::Vec3SGrid& sigmaT, const openvdb::Vec3SGrid& sig
   }
 }
 
+/// Voxel edge lengths (file units) of a material grid. Zero, NaN or Inf make the grid's
+/// index<->world maps singular (OpenVDB throws ArithmeticError deep inside resampling);
+/// beyond the range, voxel positions leave the scene's coordinate range or collapse in
+/// float.
+constexpr double kMinVoxelSize = 1e-6;
+constexpr double kMaxVoxelSize = 1e6;
+
+/// What is wrong with the grid's transform, or "" when it is usable. The axes come from
+/// applying the map, not from getAffineMap(), which itself throws on a singular matrix.
+std::string transformProblem(const openvdb::GridBase& grid) {
+  const openvdb::math::Transform& transform = grid.constTransform();
+  const openvdb::math::MapBase::ConstPtr map = transform.baseMap();
+  if (!map || !transform.isLinear())
+    return "grid '" + grid.getName() + "' has a " + (map ? transform.mapType() : std::string("missing")) +
+           " transform, expected a linear one (scale, rotation, translation)";
+  openvdb::Vec3d origin(0.0), size(0.0);
+  openvdb::Mat3d axes;
+  bool usable = true;
+  try {
+    origin = map->applyMap(openvdb::Vec3d(0.0));
+    for (int axis = 0; axis < 3; ++axis) {
+      openvdb::Vec3d unit(0.0);
+      unit[axis] = 1.0;
+      const openvdb::Vec3d edge = map->applyMap(unit) - origin;
+      axes.setRow(axis, edge);
+      size[axis] = edge.length();
+    }
+  } catch (const openvdb::Exception&) {
+    usable = false;
+  }
+  const double det = axes.det();
+  for (int axis = 0; axis < 3; ++axis)
+    usable = usable && std::isfinite(origin[axis]) && size[axis] >= kMinVoxelSize && size[axis] <= kMaxVoxelSize;
+  // Sheared to a plane: every edge in range, yet no volume.
+  usable = usable && std::abs(det) >= 1e-6 * size[0] * size[1] * size[2];
+  if (usable) return {};
+  return "grid '" + grid.getName() + "' has voxel size " + vec(size) + " (origin " + vec(origin) +
+         "); each voxel edge must be in [" + number(kMinVoxelSize) + ", " + number(kMaxVoxelSize) +
+         "] file units, and the voxels must not be flat";
+}
+
 /// The file's grids and metadata read as a material set, with the problems that are
 /// not about values (wrong types, duplicate names, units).
 struct InterpretedFile {
@@ -173,6 +215,11 @@ InterpretedFile interpret(const VdbContents& contents) {
     if (!required && name != kG) continue;
     if (!seen.insert(name).second) {
       result.structural.push_back("more than one grid is named '" + name + "'");
+      continue;
+    }
+    if (std::string problem = transformProblem(*grid); !problem.empty()) {
+      result.structural.push_back(problem);
+      result.wrongType.insert(name);  // its values are not checked either
       continue;
     }
     const char* expected = required ? "Vec3SGrid" : "FloatGrid";
@@ -280,7 +327,7 @@ void saveMaterialSet(const MaterialSet& set, const fs::path& file) {
       throw InputError(name + ": cannot write the VDB file: " + e.what());
     }
     stream.close();
-    if (stream.fail()) throw InputError(name + ": cannot write the VDB file (disk full or file too large?)");
+    if (stream.fail()) throwWriteFailed(file, errno);
   });
 }
 
@@ -352,6 +399,12 @@ void printGrid(const openvdb::GridBase& grid, std::ostream& out) {
     out << "  index bounding box: empty\n";
   } else {
     out << "  index bounding box: " << coord(box.min()) << " .. " << coord(box.max()) << "\n";
+  }
+  const std::string problem = transformProblem(grid);
+  if (!problem.empty()) {
+    // Printing a singular map builds its (impossible) affine inverse and throws.
+    out << "  transform (" << transform.mapType() << "): unusable, see validation\n";
+    return;
   }
   out << "  transform (" << transform.mapType() << "):\n";
   std::ostringstream transformText;
