@@ -180,6 +180,25 @@ TEST(Mesh, PlyFileLoads) {
   EXPECT_NEAR(signedVolume(mesh), 1.0, 1e-6);
 }
 
+TEST(Mesh, TinyCubeFileStaysClosedAtEverySize) {
+  // Closedness is decided by exact vertex identity, not an absolute distance: a 3e-6
+  // cube used to have vertices merged across its faces and was refused as not manifold
+  // while 1e-5 and 1e-10 passed.
+  test::TempDir dir;
+  for (const double side : {1e-3, 1e-5, 6e-6, 2e-6, 2e-8, 2e-10}) {
+    SCOPED_TRACE(side);
+    std::ostringstream obj;
+    obj.precision(17);
+    for (int i = 0; i < 8; ++i)
+      obj << "v " << ((i & 1) ? side : 0.0) << " " << ((i & 2) ? side : 0.0) << " " << ((i & 4) ? side : 0.0) << "\n";
+    for (const char* face : kCubeFaces) obj << face;
+    test::writeText(dir / "cube.obj", obj.str());
+    const TriangleMesh mesh = loadMesh(fileSource(dir / "cube.obj"), {});
+    EXPECT_EQ(mesh.positions.size(), 8u);
+    EXPECT_NO_THROW(requireClosedMesh(mesh));
+  }
+}
+
 TEST(Mesh, StlFileIsWeldedIntoAClosedMesh) {
   // STL stores three separate corners per facet; without welding every edge is a boundary.
   const glm::vec3 corner[8] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},

@@ -181,6 +181,8 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Saves and autosaves write temporaries; closing the terminal or Ctrl-C must not leave them.
+  sslpv::removeTemporariesOnSignals();
   Options options;
   CLI::App app{"sslpv edit: paint sigma_t, sigma_s and g into a scene's material set with a live SSLPV preview", "sslpv edit"};
   app.add_option("scene", options.scene, "Scene JSON file")->required();
