@@ -199,6 +199,12 @@ TEST_F(HostileInput, StrokeFileThatIsAFifoIsRefused) {
   expectRejected(r, {"strokes.json", "FIFO"});
 }
 
+TEST_F(HostileInput, ImageToCompareThatIsAFifoIsRefusedAsSuch) {
+  const fs::path fifo = makeFifo("a.pfm");
+  writeText(dir_ / "b.pfm", "PF\n1 1\n-1.0\n" + std::string(12, '\0'));
+  expectRejected(runBounded({"compare", fifo.string(), (dir_ / "b.pfm").string()}), {"a.pfm", "FIFO"});
+}
+
 // --- item: NUL in a path -----------------------------------------------------------------
 
 TEST_F(HostileInput, NulInsideMeshPathIsRefused) {

@@ -21,6 +21,7 @@
 
 #include "volume/atomic_file.h"
 #include "volume/error.h"
+#include "volume/input_file.h"
 
 namespace sslpv {
 namespace fs = std::filesystem;
@@ -340,7 +341,8 @@ void writeImage(const Image& image, const fs::path& file, float exposure) {
 
 Image readImage(const fs::path& file) {
   std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) throw InputError(file.string() + ": image file not found");
+  if (!fs::exists(file, ec)) throw InputError(file.string() + ": image file not found");
+  requireRegularFile(file, "image");  // a FIFO or /dev/zero would never end
   switch (formatOf(file)) {
     case ImageFormat::Png: return readPng(file);
     case ImageFormat::Pfm: return readPfm(file);
