@@ -1,4 +1,4 @@
-// The `sslpv` command line: one binary, subcommands (DESIGN.md "Command line").
+// The `sslpv` command line: one binary, subcommands (docs/design.md §5; flags in the README).
 // Exit codes: 0 success, 1 internal error, 2 bad input, 3 not enough resources.
 #include <CLI/CLI.hpp>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Deterministic closed test meshes for the issue-3 benchmark, at the triangle counts the
+// Deterministic closed test meshes for frame_bench, at the triangle counts the
 // benchmark sweeps (about 32K, 110K, 323K and 7.2M), generated rather than shipped.
 #include <array>
 #include <cstddef>

@@ -1,4 +1,4 @@
-// How much light comes round an edge, SSLPV against the path tracer (issue 4). A box lit
+// How much light comes round an edge, SSLPV against the path tracer (docs/design.md §6.7.9). A box lit
 // from straight above only, seen square-on through one of its side faces, which no light
 // reaches directly: everything that face shows entered the top and turned the edge. The
 // face is compared band by band below the edge. It is the shipped ketchup_box's largest

@@ -1,4 +1,4 @@
-// How far light spreads along a lit face, SSLPV against the path tracer (issue 4). The
+// How far light spreads along a lit face, SSLPV against the path tracer (docs/design.md §6.7.9). The
 // calibration makes a thick slab's total diffuse reflectance exact (slab_calibration), but
 // not where on the face that light comes out: a thick slab lit on a disk only, seen from
 // straight above, compared ring by ring. Inside the disk the light that scattered near

@@ -1,4 +1,4 @@
-// Thick-slab calibration table (issue 4): for each of Jensen's eleven measured materials
+// Thick-slab calibration table (docs/design.md §6.7.4): for each of Jensen's eleven measured materials
 // and each RGB channel, the diffuse reflectance of a thick homogeneous slab under
 // normal directional light as the reference path tracer sees it, as the dipole
 // predicts it, and as SSLPV renders it with the calibrated and with the seed scheme.

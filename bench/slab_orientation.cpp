@@ -1,4 +1,4 @@
-// Where calibrated SSLPV leaves the thick-slab case it is calibrated on (issue 4): the
+// Where calibrated SSLPV leaves the thick-slab case it is calibrated on (docs/design.md §6.7.3, §6.7.5): the
 // same thick slab lit at oblique incidence, and the slab tilted against the grid (its
 // boundary a staircase of cells) lit and seen along its normal. Prints SSLPV over the
 // path tracer per channel; the normal, grid-aligned row is the calibrated case itself.

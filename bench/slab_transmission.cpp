@@ -1,4 +1,4 @@
-// Light that crosses an object, SSLPV against exact transport (issue 4). A slab 60 x 60 mm
+// Light that crosses an object, SSLPV against exact transport (docs/design.md §6.7.9). A slab 60 x 60 mm
 // wide and L thick, lit from above by a directional light along its normal and seen from
 // below along its normal: the radiance of its unlit face's middle, where the light comes
 // out only after crossing the slab. Ground truth is adding-doubling for the same slab

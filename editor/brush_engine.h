@@ -1,6 +1,6 @@
 #pragma once
-// The brush engine: paints σt, σs and g into a material set's OpenVDB grids (DESIGN.md
-// "Material set"), with an unbounded, exact undo/redo history. Headless (no VTK, no
+// The brush engine: paints σt, σs and g into a material set's OpenVDB grids (docs/design.md
+// §4), with an unbounded, exact undo/redo history. Headless (no VTK, no
 // Vulkan): `sslpv paint` and the editor drive the same code.
 //
 // Space. Painting happens in the object's rest space, which is the grids' space. Stroke
@@ -10,7 +10,7 @@
 // convention; the grid's "world" is the rest space).
 //
 // Material of a voxel. A voxel inactive in a grid takes the base material for that grid
-// (DESIGN.md). When the brush writes a voxel it makes its whole material explicit: the
+// (docs/design.md §4). When the brush writes a voxel it makes its whole material explicit: the
 // voxel becomes active in all three grids (σt, σs, g), unless the result equals the base
 // material exactly in all three, in which case it becomes inactive in all three (value set
 // to each grid's background). So erasing restores the base, and smoothing an unpainted

@@ -1,4 +1,4 @@
-// End-to-end tests of the `sslpv` binary as a user runs it (DESIGN.md "Command line"):
+// End-to-end tests of the `sslpv` binary as a user runs it (docs/design.md §3, §5):
 // every bad input exits 2 (never a signal) with exactly one "sslpv: error: ..." line on
 // stderr naming the file and the key path / grid / voxel, leaves an existing output file
 // byte-identical and leaves no temporary files behind. Plus the happy paths and a render

@@ -1,4 +1,4 @@
-// The calibrated lattice's per-cell diffusion coefficient (lpv_calibration.h, point 7):
+// The calibrated lattice's per-cell diffusion coefficient (docs/design.md §6.7.7):
 // a homogeneous medium renders the same at any conductance, and light crossing an
 // interface between media of different D divides as diffusion theory says, where the
 // lattice with one D for every cell sends twice as much across.

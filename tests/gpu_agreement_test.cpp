@@ -1,5 +1,5 @@
 // The Vulkan backend must show what the CPU backend computes: on every shipped example
-// and on randomized small scenes, the two images agree within the tolerance.
+// and on randomized small scenes, the two images agree within the tolerances below.
 //
 // Pixel classes as in image_agreement.h (silhouette and edge pixels are where the
 // rasterizer and the ray caster may see different triangles). Expectations:

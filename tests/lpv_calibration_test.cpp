@@ -25,11 +25,11 @@ struct Medium {
   double sigmaSPrime, sigmaA;
   double sigmaT() const { return sigmaSPrime + sigmaA; }
   double albedo() const { return sigmaSPrime / sigmaT(); }
-  /// Transport's asymptotic decay constant κ (lpv_calibration.h, point 2).
+  /// Transport's asymptotic decay constant κ (docs/design.md §6.7.2).
   double kappa() const { return asymptoticDecay(albedo()) * sigmaT(); }
 };
 
-/// R_lpv of lpv_calibration.h for a medium, cell size and ior: the closed form the exit
+/// R_lpv (docs/design.md §6.7.4) for a medium, cell size and ior: the closed form the exit
 /// gain is built on (checked against the propagation below).
 /// R_lpv of light injected `depth` deep; by default where the calibrated scheme injects
 /// the medium's light (CellTransport::injectionDepth).
@@ -260,7 +260,7 @@ TEST(LpvCalibration, ExitGainMakesTheLatticeReflectTheMediumsRd) {
   }
 }
 
-// The oblique-entry gain (lpv_calibration.h, point 5), end to end through the real
+// The oblique-entry gain (docs/design.md §6.7.5), end to end through the real
 // injection and propagation: light entering the wide slab at θi must come back out as the
 // medium's Rd(θi) per entering power from adding-doubling, as normal incidence does. At a
 // node of the gain (cos² θi = 0.5, 0.25) only float accumulation separates them; between

@@ -1,5 +1,5 @@
 // Material-set files (load, save, validation, inspect, corrupt input) and the point
-// sampling of the material field (DESIGN.md "Material set").
+// sampling of the material field (docs/design.md §4).
 #include "volume/material_set.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The measured-material table (Jensen et al. 2001, as listed in DESIGN.md) and the preset
+// The measured-material table (Jensen et al. 2001, as listed in docs/design.md §6.11) and the preset
 // conversion sigma_s = sigma_s' / (1 - g), sigma_t = sigma_s + sigma_a, per scene unit.
 #include <gtest/gtest.h>
 
@@ -23,7 +23,7 @@ TEST(Material, TableHasTheElevenJensenMaterialsInOrder) {
 }
 
 TEST(Material, TableValuesMatchDesignDocument) {
-  // Spot checks copied from DESIGN.md "Measured materials".
+  // Spot checks copied from docs/design.md §6.11 "Measured materials".
   const auto& skin1 = find("skin1");
   EXPECT_FLOAT_EQ(skin1.sigmaSPrime.r, 0.74f);
   EXPECT_FLOAT_EQ(skin1.sigmaSPrime.g, 0.88f);

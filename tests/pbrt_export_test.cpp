@@ -318,7 +318,7 @@ INSTANTIATE_TEST_SUITE_P(Shapes, PbrtCamera,
 
 // --- lights ---------------------------------------------------------------------------------
 
-// Units (DESIGN.md): point/spot intensity W/sr and directional irradiance are pbrt's I and
+// Units (docs/design.md §6.12): point/spot intensity W/sr and directional irradiance are pbrt's I and
 // L unchanged (pbrt-v4 normalises RGB emission to its illuminant's luminance, and the
 // default sensor's imaging ratio is 1). Spot: pbrt's coneangle is the half angle, and a
 // conedeltaangle of 0 is a hard edge like sslpv's. Distant: light goes from "from" to "to".

@@ -597,8 +597,8 @@ const glm::vec3 kBrightSigmaT(1.0f), kBrightSigmaS(0.99f);  // albedo 0.99
 const glm::vec3 kDenseSigmaT(8.0f), kDenseSigmaS(7.2f);     // albedo 0.9
 
 /// Cell i's exit gain as the neighbourhood limit left it: painted media differ in σt', so
-/// the lattice also divides each cell's gain by λ = 1 + s (1/w − 1) (lpv_calibration.h,
-/// point 7), s its survival at w = 1 and w its conductance².
+/// the lattice also divides each cell's gain by λ = 1 + s (1/w − 1) (docs/design.md
+/// §6.7.7), s its survival at w = 1 and w its conductance².
 double gainBeforeConductance(const MaterialGrid& m, const StepFactors& f, int ch, std::size_t i) {
   if (f.conductance[std::size_t(ch)].empty()) return f.exitGain[std::size_t(ch)][i];
   const double survival =

@@ -1,4 +1,4 @@
-// The strict scene contract (DESIGN.md "Scene"): every value of a full scene is read,
+// The strict scene contract (docs/design.md §3 "Scene contract"): every value of a full scene is read,
 // optional keys take their documented defaults, and every bad input is an InputError whose
 // one-line message names the file and the key path.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Thick-slab diffuse reflectance from the reference tracer (volume/slab_reflectance.h)
-// against exact transport and the dipole (issue 4). Statistical checks allow 4 standard
+// against exact transport and the dipole (docs/design.md §7). Statistical checks allow 4 standard
 // errors of the Monte Carlo mean (about one false failure in 16,000 seeds; seeds are
 // fixed) and require the standard error to be small against the value, so that noise
 // cannot make a check pass.

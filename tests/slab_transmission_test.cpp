@@ -1,4 +1,4 @@
-// Light crossing a slab (issue 4): calibrated SSLPV against exact transport
+// Light crossing a slab (docs/design.md §6.7.9): calibrated SSLPV against exact transport
 // (adding-doubling for the same slab, volume/adding_doubling.h), where the lattice is a good
 // model: marble's reduced albedo is 0.998, its diffusion length 8 mm. At 0.6 mm cells it
 // is within 1-5 % of exact at 4 and 10 mm (bench/slab_transmission); 8 % catches a

@@ -1,25 +1,14 @@
 #pragma once
-// Diffuse reflectance of a semi-infinite, isotropically scattering medium behind a smooth
-// dielectric boundary, by the adding-doubling method (van de Hulst, Multiple Light
-// Scattering, 1980; Prahl, "The adding-doubling method", in Optical-Thermal Response of
-// Laser-Irradiated Tissue, 1995). It is the boundary target of the calibrated SSLPV
-// (lpv_calibration.h, issue 4): unlike the dipole it is exact transport for any albedo, up
-// to a quadrature error that the tests show converging.
-//
-// Method. Directions inside the medium are Gauss–Legendre bins in μ = cos θ; light is
-// tracked as power per bin, which keeps the matrices' column sums equal to the bin's
-// reflected plus transmitted fraction (energy bookkeeping is a column sum). A layer of
-// optical thickness 2^-k ≤ μ_min / 2 gets its reflection and transmission exactly from the
-// exponential of the discrete-ordinate equations (a Taylor series that converges fast
-// for so thin a layer and conserves power exactly at albedo 1), then is doubled,
-// R2 = R + T R (I - R R)^-1 T and T2 = T (I - R R)^-1 T, until the slab transmits a
-// negligible fraction: its reflection is then that of the half-space. The normally
-// incident beam is carried beside the bins as an extra column (it is not a node). The
-// boundary is a last added layer: a bin reaching it from inside is reflected back into
-// itself with the Fresnel reflectance F(μ) (1 under total internal reflection) and the rest
-// leaves. For η > 1 the bins are split at the critical cosine μc, where F has a kink, and
-// the upper interval uses μ = μc + (1 - μc) s², which turns the sqrt(μ - μc) rise of 1 - F
-// into a smooth function of s.
+// Diffuse reflectance of a semi-infinite (or finite), isotropically scattering medium
+// behind a smooth dielectric boundary, by the adding-doubling method (van de Hulst,
+// Multiple Light Scattering, 1980; Prahl, "The adding-doubling method", in
+// Optical-Thermal Response of Laser-Irradiated Tissue, 1995): exact transport for any
+// albedo up to a quadrature error the tests show converging. It is the calibrated
+// scheme's boundary target. Gauss–Legendre bins in μ inside, light tracked as power per
+// bin (energy bookkeeping is a column sum), a thin starting layer from the
+// discrete-ordinate equations' exponential, doubled until the slab transmits a negligible
+// fraction; the Fresnel boundary is a last added layer, with the bins split at the
+// critical cosine for η > 1. Method in full: docs/design.md §6.10 "Adding-doubling".
 #include <vector>
 
 namespace sslpv {

@@ -1,30 +1,13 @@
 #pragma once
 // The angular shape of the light a thick medium sends out through its boundary, for the
-// calibrated SSLPV shading (issue 4, lpv_calibration.h item 4).
-//
-// Why: the calibrated exit gain makes the power a thick slab reflects exact, but the
-// lattice's light leaves as a Lambertian field inside the boundary, L_o = T(μo)/η² · L_in.
-// The medium's does not: at low reduced albedo α' it is close to single scattering,
-// radiance ∝ 1/(1 + μ) at η = 1 (Chandrasekhar: ∝ H(μ)/(1 + μ) for any α' under normal
-// incidence), so a Lambertian exit is too bright near the normal (+11 % for ketchup blue
-// at η = 1.3, +24 % at η = 1, view 10° off the normal).
-//
-// The law: outside radiance = T(μo)/η² · h(μo; α', η) · L_in, with h the radiance of the
-// adding-doubling half-space (normal incidence) just below the boundary along the
-// direction that refracts into μo, less its once-scattered part α'(1 − F(0))/(4π(1 + μ))
-// (the shading adds that light itself, volume/single_scattering.h), normalised so that
-//    2 ∫0^1 T(μo)/η² h(μo) μo dμo = 2 ∫0^1 T(μo)/η² μo dμo = diffuseBoundaryTransmittance(η):
-// the total exitant power of every cell is exactly what the Lambertian law gave, so the
-// exit gain (calibrated against that power) and its tests hold unchanged. h = 1 is the
-// old law. Keeping T(μo) outside the table leaves h smooth (the Fresnel kink at the
-// critical angle is not tabulated).
-//
+// calibrated SSLPV shading: outside radiance = T(μo)/η² · h(μo; α', η) · L_in, h the
+// adding-doubling half-space's radiance just below the boundary (less its once-scattered
+// part, which the shading adds itself), normalised so every cell's exitant power equals
+// the Lambertian law's (h = 1), which keeps the exit gain's calibration unchanged.
 // Table: h at μo = j / SSLPV_EXIT_LAW_MU_INTERVALS and t = sqrt(1 - α') =
-// k / SSLPV_EXIT_LAW_ALBEDO_INTERVALS (volume/lpv_constants.h), bilinear; the node values
-// come from the adding-doubling bins interpolated by a polynomial through the escaping
-// nodes (barycentric; in s, μ = μc + (1 - μc)s², for η > 1), and each row is scaled so the
-// integral above holds for the bilinear interpolant itself. The GPU shading
-// (shaders/shade.comp) reads the same floats and interpolates the same way.
+// k / SSLPV_EXIT_LAW_ALBEDO_INTERVALS (volume/lpv_constants.h), bilinear, each row
+// rescaled so the normalisation holds for the interpolant itself; shaders/shade.comp reads
+// the same floats the same way. Why and how: docs/design.md §6.7.6 "Exit shape".
 #include <vector>
 
 namespace sslpv {

@@ -43,7 +43,7 @@ struct RenderReport {
   PropagationResult propagation;
 };
 
-/// Dirty flags of the frame's stages, following the data flow (DESIGN.md): each change
+/// Dirty flags of the frame's stages, following the data flow (docs/design.md §2): each change
 /// marks the first stage it affects and everything downstream of it.
 class StageDirty {
  public:

@@ -1,6 +1,6 @@
 #pragma once
 // Error metrics between a test image A (an SSLPV render) and a reference image B (the
-// path tracer), over the pixels that show the object (DESIGN.md "Accuracy methodology").
+// path tracer), over the pixels that show the object (docs/design.md §7 "Accuracy methodology").
 //
 // Definitions (n = masked pixels, sums over masked pixels p and channels c = R, G, B):
 //   mean_B      = Σ B / (3n), likewise mean_A; ratio = mean_A / mean_B (a global energy

@@ -1,4 +1,5 @@
-// Injection: refracted flux enters the LPV as clamped-cosine L1 lobes (DESIGN.md).
+// Injection: refracted flux enters the LPV as clamped-cosine L1 lobes (seed scheme) or as
+// isotropic sources at the medium's depth (calibrated), docs/design.md §6.2 "Injection".
 #include <algorithm>
 #include <cmath>
 #include <cstddef>

@@ -1,4 +1,5 @@
-// Calibrated SSLPV transport; the model and its reasons are in lpv_calibration.h.
+// Calibrated SSLPV transport; the model and its reasons are in docs/design.md §6.7
+// "Calibrated scheme"; the closed form below is its §6.7.4.
 //
 // Derivation of the lattice's shaded reflectance R_lpv (semi-infinite layer stack n = 1,
 // 2, ..., layer 0 outside; light injected isotropically, split between layers m and m + 1

@@ -154,7 +154,7 @@ struct StepFactors {
   std::array<std::vector<float>, 3> retention;
   /// Calibrated scheme with a spatially varying diffusion coefficient: per channel, per
   /// cell, sqrt(D / D_ref); light crossing the face between cells i and j is weighted by
-  /// conductance[i] · conductance[j] (lpv_calibration.h, point 7). Empty (all 1) when the
+  /// conductance[i] · conductance[j] (docs/design.md §6.7.7). Empty (all 1) when the
   /// medium's D is uniform, and in the seed scheme.
   std::array<std::vector<float>, 3> conductance;
   /// Calibrated scheme: per channel, per cell, the gain on the injected light as it enters
@@ -186,7 +186,7 @@ bool keepsCellsIsotropic(const StepFactors& factors);
 
 /// Beyond this ratio between the largest and the smallest diffusion coefficient of a
 /// grid's cells (per channel), the densest cells pass light faster than their own D: the
-/// propagation's step count grows as the ratio (lpv_calibration.h, point 7).
+/// propagation's step count grows as the ratio (docs/design.md §6.7.7).
 constexpr double kMaxDiffusivityContrast = 8.0;
 
 /// Per channel, per active cell, sqrt(D / D_ref) of the calibrated scheme's lattice
@@ -196,7 +196,7 @@ std::array<std::vector<float>, 3> diffusivityConductance(const MaterialGrid& mat
 /// Makes calibrated `factors` (conductance still empty) pass light through each face at
 /// conductance[i] · conductance[j] of the rate they were computed for, keeping each
 /// homogeneous region's accumulated light, as read through the exit and fresh gains,
-/// what it was (lpv_calibration.h, point 7). Values in (0, 1].
+/// what it was (docs/design.md §6.7.7). Values in (0, 1].
 void applyConductance(const MaterialGrid& material, std::array<std::vector<float>, 3> conductance,
                       StepFactors& factors);
 

@@ -1,5 +1,5 @@
 #pragma once
-// Per-brick majorants for the reference path tracer (issue 4): a coarse grid of bricks
+// Per-brick majorants for the reference path tracer (docs/design.md §7): a coarse grid of bricks
 // over the object's world bounds, each holding per channel an upper bound of the
 // material field's σt inside the brick. Delta and ratio tracking sample free flights
 // brick by brick with the local bound instead of one global bound, so a dense blob in a

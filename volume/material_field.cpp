@@ -1,4 +1,4 @@
-// The one material field every consumer samples (DESIGN.md "Material set"): point
+// The one material field every consumer samples (docs/design.md §4): point
 // samples, exact box averages and the resampling into the LPV material grid.
 #include <tbb/blocked_range3d.h>
 #include <tbb/parallel_for.h>

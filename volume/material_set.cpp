@@ -1,4 +1,4 @@
-// Material-set files: load, validate, save and inspect (DESIGN.md "Material set").
+// Material-set files: load, validate, save and inspect (docs/design.md §4 "Material sets and the material field").
 // Reading goes through readVdbFileIsolated: OpenVDB's parser is not safe on corrupt files.
 #include "volume/material_set.h"
 
@@ -242,7 +242,7 @@ InterpretedFile interpret(const VdbContents& contents) {
     else
       result.set.units = text->value();
   } else {
-    result.unitsAssumed = true;  // DESIGN: missing units mean millimetres
+    result.unitsAssumed = true;  // missing units mean millimetres (docs/design.md §4)
   }
   if (openvdb::Metadata::ConstPtr creator = meta["creator"]) result.set.creator = creator->str();
   return result;

@@ -1,6 +1,6 @@
 #pragma once
 // Material sets: OpenVDB files with sigma_t, sigma_s (Vec3SGrid) and g (FloatGrid), and
-// the one continuous material field every consumer samples (DESIGN.md "Material set").
+// the one continuous material field every consumer samples (docs/design.md §4).
 #include <openvdb/openvdb.h>
 
 #include <filesystem>

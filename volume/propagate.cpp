@@ -1,5 +1,7 @@
 // LPV propagation on the CPU: gather from 6 neighbours through 5 faces each
 // (Kaplanyan-Dachsbacher), then extinction and Henyey-Greenstein scattering per cell.
+// The face solid angles, the energy normalisation, the calibrated scheme's c0 stencil and
+// the Chebyshev --steps auto are derived in docs/design.md §6.3, §6.7.1 and §6.9.
 #include <pmmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -1,6 +1,6 @@
 #pragma once
 // Ground truth for SSLPV: a Monte Carlo volumetric path tracer over exactly the scene
-// `sslpv render` reads (issue 4). Delta tracking (free flights) and residual ratio
+// `sslpv render` reads (docs/design.md §7). Delta tracking (free flights) and residual ratio
 // tracking (shadow rays) with a majorant and a minorant per brick and channel
 // (volume/majorant_grid.h), exact exp(-σt·length) and no field lookups in bricks the
 // material set does not reach, Henyey–Greenstein phase

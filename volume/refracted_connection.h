@@ -1,6 +1,6 @@
 #pragma once
 // Exact next-event connections through a flat face of a smooth dielectric boundary, for
-// the reference path tracer (issue 4).
+// the reference path tracer (docs/design.md §7).
 //
 // Why: a point, spot or directional light outside reaches a point x inside only along
 // the path that refracts at the boundary, a delta event that a shadow ray along the

@@ -1,5 +1,5 @@
 #pragma once
-// The scene contract (DESIGN.md): parsed strictly from JSON. Unknown keys, wrong types,
+// The scene contract (docs/design.md §3; keys in the README's "Scene file"): parsed strictly from JSON. Unknown keys, wrong types,
 // missing required keys and out-of-range values are InputErrors naming the key path,
 // e.g. "scene.json: lights[1].intensity: expected an array of 3 non-negative numbers".
 #include <filesystem>

@@ -1,28 +1,14 @@
 #pragma once
-// The calibrated shading's single-scattering term (issue 4): light that scatters exactly
-// once between entering the object and leaving it toward the camera, integrated per pixel
-// along the refracted view ray instead of carried by the lattice.
-//
-// Why: at low reduced albedo α' nearly all the light a medium returns has scattered once
-// (ketchup green and blue, α' 0.07 and 0.02), and where it comes out depends on the
-// geometry on the scale of a mean free path: round a lit edge it leaves the unlit face
-// within 1/σt' of the edge. The lattice spreads it as diffusion from an isotropic source
-// z0 deep, which put a band of light about z0 below the edge (1.5-2x the path tracer's on
-// ketchup green and blue, bench/edge_crossing) and left the first millimetre dark. The
-// single-scattered light has a closed form per point, so the shading integrates it, and
-// the lattice's coupling gain targets the rest of the thick slab's reflectance,
-// Rd − Rd₁ (singleScatteringPerEntering, lpv_calibration.h).
-//
-// The term, with the similarity relation's isotropic medium (σs' = σs (1 − g),
-// σt' = σt − g σs, as the calibration uses): along the refracted view ray t from the
-// surface point p, L(p, −t) = ∫ σs'(q) / (4π) Σ_lights E_in(q) exp(−σt'(q) s'_l(q))
-// exp(−τ(p, q)) ds, q = p + s t, and the camera sees T(θo) / η² of it. E_in is the light's
-// irradiance refracted into the medium across its beam, E T(θi) cos θi / cos θt, and s'_l
-// the refracted path from the light's entry point to q, Jensen et al.'s (2001) planar
-// estimate s cos θi / cos θt from the straight distance s to the surface along the
-// light's ray, which the light's shadow map gives (its texel's entry point). The light leg
-// takes σt' at q; the view leg integrates σt' along the ray. Samples are midpoints in
-// u = 1 − exp(−σt'(p) s), so a homogeneous medium's view-leg attenuation is exact.
+// The calibrated shading's single-scattering term: light that scatters exactly once
+// between entering the object and leaving it toward the camera, integrated per pixel
+// along the refracted view ray instead of carried by the lattice (whose coupling gain
+// targets the rest, Rd − Rd₁). With the similarity relation's isotropic medium:
+// L(p, −t) = ∫ σs'(q)/(4π) Σ_lights E_in(q) exp(−σt'(q) s'_l(q)) exp(−τ(p, q)) ds, q = p + s t,
+// E_in the light's refracted irradiance from its shadow map's texel through q, s'_l
+// Jensen et al.'s (2001) planar refracted path, samples at midpoints in
+// u = 1 − exp(−σt'(p) s); the camera sees T(θo) / η² of it. Radiance in scene units as
+// the renderer's. Why, and the rejection past a terminator: docs/design.md §6.8
+// "Single scattering" and §6.7.8.
 #include <glm/vec3.hpp>
 #include <vector>
 

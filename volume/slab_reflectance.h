@@ -1,8 +1,8 @@
 #pragma once
 // Total diffuse reflectance Rd of a thick homogeneous slab under broad normal
 // illumination, measured with the reference path tracer, and the closed forms it is
-// judged against (issue 4; DESIGN.md "Accuracy methodology"). The calibration of the
-// per-step LPV factors fits against estimateSlabReflectance().
+// judged against (docs/design.md §7): the check that the path tracer agrees with exact
+// transport (adding-doubling, which the calibrated scheme targets) and with the dipole.
 #include <cstdint>
 #include <glm/vec3.hpp>
 
@@ -48,7 +48,7 @@ SlabReflectance estimateSlabReflectance(const MaterialSample& material, double i
                                         const SlabReflectanceOptions& options = {});
 
 /// Jensen et al. 2001 dipole total diffuse reflectance Rd(α') with A = (1+Fdr)/(1-Fdr),
-/// Fdr = -1.440/η² + 0.710/η + 0.668 + 0.0636η (DESIGN.md "Physics notes").
+/// Fdr = -1.440/η² + 0.710/η + 0.668 + 0.0636η (Egan and Hilgeman's fit, as Jensen et al. use it).
 double dipoleRd(double albedoPrime, double eta);
 
 /// Chandrasekhar's H-function for isotropic scattering with single-scattering albedo

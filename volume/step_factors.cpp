@@ -1,5 +1,7 @@
 // Per-cell step factors: the propagation's per-step band factors, and in the calibrated
-// scheme the exit gains, boundary retentions and injection depths the surface needs.
+// scheme the exit gains, boundary retentions and injection depths the surface needs
+// (docs/design.md §6.7.3 for the staircase and grid-phase rules, §6.7.4 for the exit-gain
+// limit, §6.7.7 for the conductances).
 #include <tbb/parallel_for.h>
 
 #include <algorithm>

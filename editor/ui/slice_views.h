@@ -1,7 +1,7 @@
 #pragma once
 // Three axis-aligned slices through the object's material field, shown both inside the 3D
 // view and in their own 2D views, with one colour legend. The slices are sampled from the
-// same MaterialField every consumer uses (DESIGN.md "Material set"), in world space, so
+// same MaterialField every consumer uses (docs/design.md §4), in world space, so
 // what the artist sees is what the renderer resamples.
 #include <vtkSmartPointer.h>
 
