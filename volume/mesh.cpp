@@ -253,9 +253,14 @@ TriangleMesh loadMeshFile(const fs::path& path) {
 
   static const IsolatedParser kParser{"mesh file", "the assimp importer", "the mesh reader process"};
   const std::size_t bytes = fs::file_size(path, ec);
+  const std::size_t size = ec ? 0 : bytes;
+  // Fuzzing also found a 200-byte PLY (a property line cut in half) on which assimp never
+  // returns. Importers read at tens of MB/s, so 5 s plus 1 s per MiB only stops such a
+  // loop, well before a user would give up on the tool.
+  const auto timeout = std::chrono::seconds(5 + size / (1u << 20));
   // Assimp's scene graph plus post-processing copies: tens of bytes per byte of text.
-  ChildOutput output = runIsolated(name, kParser, isolatedMemoryBudget(ec ? 0 : bytes, 64),
-                                   isolatedTimeout(ec ? 0 : bytes), [&path](int fd) { return importInChild(path, fd); });
+  ChildOutput output = runIsolated(name, kParser, isolatedMemoryBudget(size, 64), timeout,
+                                   [&path](int fd) { return importInChild(path, fd); });
   if (output.parseError)
     throw InputError(output.bytes.empty() ? name + ": cannot load mesh: unknown error" : output.bytes);
   TriangleMesh mesh = decodeChildMesh(output.bytes, name);
