@@ -2,6 +2,7 @@
 // watertightness checks SSLPV relies on.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -341,6 +342,38 @@ TEST(Mesh, GarbageFileIsAnInputErrorNamingIt) {
     EXPECT_EQ(message.rfind((dir / name).string() + ": ", 0), 0u) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
+}
+
+// Found by fuzz/mesh_fuzz: faces written without their vertex count ("0 2 1" instead of
+// "3 0 2 1") made assimp's triangulation fail its internal assertion and abort the whole
+// process. The import now runs in a reader child, so the abort is this file's InputError.
+TEST(Mesh, PlyThatAbortsAssimpIsAnInputErrorNamingIt) {
+  test::TempDir dir;
+  const fs::path file = dir / "faces_without_counts.ply";
+  test::writeText(file,
+                  "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                  "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                  "0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n");
+  const std::string message = errorOf(fileSource(file));
+  EXPECT_EQ(message.rfind(file.string() + ": corrupt mesh file (the assimp importer crashed with signal 6", 0), 0u)
+      << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+}
+
+// Found by fuzz/mesh_fuzz: assimp never returns on this PLY (a property line cut in half),
+// so sslpv hung; the reader child is stopped after a few seconds instead.
+TEST(Mesh, PlyOnWhichAssimpHangsIsAnInputErrorWithinSeconds) {
+  test::TempDir dir;
+  const fs::path file = dir / "cut_property.ply";
+  test::writeText(file,
+                  "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                  "property floaroperty float z\nelement face 4\nproperty list uchar int vertex_indices\n"
+                  " 0 0\n1 0 0\n0 1 0\n0 0 1\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n");
+  const auto start = std::chrono::steady_clock::now();
+  const std::string message = errorOf(fileSource(file));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(message, file.string() + ": reading did not finish within 5 s; the file looks corrupt");
+  EXPECT_LT(seconds, 30.0);
 }
 
 TEST(Mesh, FileWithoutTrianglesIsRejected) {

@@ -27,6 +27,7 @@
 #include "volume/error.h"
 #include "volume/input_file.h"
 #include "volume/input_ranges.h"
+#include "volume/isolated_child.h"
 
 namespace sslpv {
 namespace {
@@ -177,19 +178,9 @@ void requireRegularMaterialLibraries(const fs::path& obj) {
   }
 }
 
-TriangleMesh loadMeshFile(const fs::path& path) {
+/// The assimp import proper; runs in the reader child (see loadMeshFile).
+TriangleMesh importWithAssimp(const fs::path& path) {
   const std::string name = path.string();
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(name + ": mesh file not found");
-  if (!fs::is_regular_file(path, ec)) throw InputError(name + ": mesh path is not a regular file");
-  requireRegularFile(path, "mesh file");  // a /proc file passes the test above
-  if (!std::ifstream(path, std::ios::binary).good())
-    throw InputError(name + ": cannot read mesh file (" + std::strerror(errno) + ")");
-
-  std::string extension = path.extension().string();
-  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".obj") requireRegularMaterialLibraries(path);
-
   Assimp::Importer importer;
   auto failure = [&] {
     std::string reason = importer.GetErrorString();
@@ -242,6 +233,77 @@ TriangleMesh loadMeshFile(const fs::path& path) {
     }
   }
   if (mesh.triangles.empty()) throw InputError(name + ": mesh file contains no triangles");
+  return mesh;
+}
+
+/// The child's result on its pipe: vertex and triangle counts (u64), then the float
+/// positions and the u32 indices.
+int importInChild(const fs::path& path, int fd) {
+  TriangleMesh mesh;
+  try {
+    mesh = importWithAssimp(path);
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    writeFully(fd, message.data(), message.size());
+    return kChildParseError;
+  }
+  const std::uint64_t counts[2] = {mesh.positions.size(), mesh.triangles.size()};
+  const bool written =
+      writeFully(fd, reinterpret_cast<const char*>(counts), sizeof counts) &&
+      writeFully(fd, reinterpret_cast<const char*>(mesh.positions.data()), mesh.positions.size() * sizeof(glm::vec3)) &&
+      writeFully(fd, reinterpret_cast<const char*>(mesh.triangles.data()), mesh.triangles.size() * sizeof(glm::uvec3));
+  return written ? kChildOk : kChildWriteError;
+}
+
+TriangleMesh decodeChildMesh(const std::string& bytes, const std::string& name) {
+  const InputError damaged(name + ": the mesh reader process returned a damaged result");
+  std::uint64_t counts[2];
+  if (bytes.size() < sizeof counts) throw damaged;
+  std::memcpy(counts, bytes.data(), sizeof counts);
+  if (counts[0] > bytes.size() || counts[1] > bytes.size() ||
+      bytes.size() != sizeof counts + counts[0] * sizeof(glm::vec3) + counts[1] * sizeof(glm::uvec3))
+    throw damaged;
+  TriangleMesh mesh;
+  mesh.name = name;
+  mesh.positions.resize(counts[0]);
+  mesh.triangles.resize(counts[1]);
+  const char* data = bytes.data() + sizeof counts;
+  std::memcpy(mesh.positions.data(), data, counts[0] * sizeof(glm::vec3));
+  std::memcpy(mesh.triangles.data(), data + counts[0] * sizeof(glm::vec3), counts[1] * sizeof(glm::uvec3));
+  for (const glm::uvec3& t : mesh.triangles)
+    if (t.x >= counts[0] || t.y >= counts[0] || t.z >= counts[0]) throw damaged;
+  return mesh;
+}
+
+/// Assimp is not hardened against corrupt files: fuzzing found malformed PLY faces that
+/// end in its internal assertions (abort), and its importers are large C++ parsers of
+/// untrusted input. So, like VDB files (volume/vdb_isolated_read.h), the import runs in a
+/// forked child and only the triangle soup it produced comes back.
+TriangleMesh loadMeshFile(const fs::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(name + ": mesh file not found");
+  if (!fs::is_regular_file(path, ec)) throw InputError(name + ": mesh path is not a regular file");
+  requireRegularFile(path, "mesh file");  // a /proc file passes the test above
+  if (!std::ifstream(path, std::ios::binary).good())
+    throw InputError(name + ": cannot read mesh file (" + std::strerror(errno) + ")");
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".obj") requireRegularMaterialLibraries(path);
+
+  static const IsolatedParser kParser{"mesh file", "the assimp importer", "the mesh reader process"};
+  const std::size_t bytes = fs::file_size(path, ec);
+  const std::size_t size = ec ? 0 : bytes;
+  // Fuzzing also found a 200-byte PLY (a property line cut in half) on which assimp never
+  // returns. Importers read at tens of MB/s, so 5 s plus 1 s per MiB only stops such a
+  // loop, well before a user would give up on the tool.
+  const auto timeout = std::chrono::seconds(5 + size / (1u << 20));
+  // Assimp's scene graph plus post-processing copies: tens of bytes per byte of text.
+  ChildOutput output = runIsolated(name, kParser, isolatedMemoryBudget(size, 64), timeout,
+                                   [&path](int fd) { return importInChild(path, fd); });
+  if (output.parseError)
+    throw InputError(output.bytes.empty() ? name + ": cannot load mesh: unknown error" : output.bytes);
+  TriangleMesh mesh = decodeChildMesh(output.bytes, name);
   weldExactDuplicates(mesh);
   return mesh;
 }
