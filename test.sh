@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Quick start, step 2: install dependencies, build, and run the whole test suite; then
-# replay and briefly fuzz every libFuzzer harness over its corpus and run the core
+# replay every libFuzzer harness's corpus and fuzz it briefly from a fixed seed and run the core
 # library's fast tests under AddressSanitizer + UndefinedBehaviorSanitizer. Any failing
 # step (test, fuzz finding, sanitizer report) fails the script.
 source "$(dirname "$0")/scripts/common.sh"
@@ -8,5 +8,5 @@ sslpv_install_packages
 sslpv_build
 (cd "$SSLPV_BUILD" && ctest -j "$(nproc)" --output-on-failure --timeout 900)
 # One clang ASan+UBSan build serves both extra steps: the fuzz harnesses and the core tests.
-"$SSLPV_ROOT/scripts/fuzz.sh" "${SSLPV_CI_FUZZ_SECONDS:-20}"
+"$SSLPV_ROOT/scripts/fuzz.sh" ci
 SSLPV_ASAN_BUILD="${SSLPV_FUZZ_BUILD:-$SSLPV_ROOT/build-fuzz}" "$SSLPV_ROOT/scripts/sanitize.sh" core
