@@ -16,6 +16,9 @@ using namespace brush_detail;
 namespace {
 
 constexpr double kMaxDabVoxels = double(1 << 26);
+/// Voxel visits of one addPoints/addRays call: about 10-30 s of painting at the rate a
+/// smooth brush paints (the slowest mode), far beyond any hand-drawn stroke.
+constexpr double kMaxStrokeVoxelVisits = double(1 << 30);
 
 }  // namespace
 
@@ -227,6 +230,15 @@ void BrushEngine::Impl::applyDab(const glm::dvec3& centre, DabResult& out, Index
 }
 
 DabResult BrushEngine::Impl::applyDabs(const std::vector<glm::dvec3>& worldDabs, std::size_t missed) {
+  // The work is bounded before any of it is done: every dab visits its index box (twice
+  // with a mirror), so a long smooth stroke of large dabs could run for minutes.
+  double visits = 0.0;
+  for (const glm::dvec3& p : worldDabs) visits += sphereBox(worldToRestPoint(p), resolved.radiusRest).voxels();
+  if (resolved.mirror) visits *= 2.0;
+  if (visits > kMaxStrokeVoxelVisits)
+    throw InputError("radius: the stroke's " + std::to_string(worldDabs.size()) + " dabs would visit " +
+                     std::to_string(std::llround(visits)) +
+                     " voxels, more than the limit of 2^30; use a smaller radius or a shorter stroke");
   DabResult out;
   out.raysMissed = missed;
   raysMissed += missed;
