@@ -494,7 +494,7 @@ TEST(Chebyshev, AutoStepsReachTheConvergedLatticeInFewerSteps) {
 // A white medium 100 mean free paths a cell (survival 1, retention -1): the iterates
 // reach their float floor (the change stalls near 1e-4 of the total) long before the
 // usual stop, which then never came: every such run went to the 10000-step cap. The
-// floor now stops it, uncapped, where the plain steps converge to the same light.
+// floor now stops it, uncapped, within the tolerance of its converged light.
 TEST(Chebyshev, AWhiteDenseCubeStopsAtItsFloatFloorInsteadOfTheCap) {
   Ball cube;
   cube.material = uniformMaterial(32, glm::vec3(100.0f), glm::vec3(100.0f), 0.0f);
@@ -506,12 +506,14 @@ TEST(Chebyshev, AWhiteDenseCubeStopsAtItsFloatFloorInsteadOfTheCap) {
   options.autoSteps = true;
   options.chebyshev = true;
   const LobeRun fast = propagateBall(cube, factors, options);
-  PropagationOptions plain;
-  plain.autoSteps = true;
-  plain.autoTolerance = plain.autoTailTolerance = 1e-9;
-  plain.maxAutoSteps = 100000;
-  const LobeRun converged = propagateBall(cube, factors, plain);
-  std::printf("semi-iteration %d steps, plain to 1e-9 %d steps, %.2e apart\n", fast.result.stepsRun,
+  // The same semi-iteration held to a 1000 times tighter stop: its fixed point (the
+  // plain steps' clamp of negative light, which retention -1 makes, leaves theirs ~10 %
+  // brighter here, with or without the floor).
+  PropagationOptions tight = options;
+  tight.autoTolerance = 1e-6;
+  tight.maxAutoSteps = 100000;
+  const LobeRun converged = propagateBall(cube, factors, tight);
+  std::printf("semi-iteration %d steps, held to 1e-6 %d steps, %.2e apart\n", fast.result.stepsRun,
               converged.result.stepsRun, relativeL1(fast.accumulated, converged.accumulated));
   EXPECT_FALSE(fast.result.capped);
   EXPECT_LT(fast.result.stepsRun, 2000);

@@ -4,6 +4,7 @@
 // arrays it really allocates and refused up front when the machine cannot give it.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <spawn.h>
