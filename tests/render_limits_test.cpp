@@ -178,9 +178,11 @@ TEST(RenderLimits, InwardOrPartlyReversedMeshesRenderAsTheOutwardOneWithAWarning
 // across and twice too bright at 0.2: all entering light was taken to diffuse, and the
 // single-scattering term's samples fell beyond the object. Now the render warns, naming
 // the optical thickness, and stays within a factor of 2 of the path tracer (measured
-// x0.48 to x0.61 here; not wildly wrong, not accurate either, as the warning says).
+// x0.55 and x0.59 here; not wildly wrong, not accurate either, as the warning says).
 TEST(RenderLimits, OpticallyThinObjectsWarnAndStayNearThePathTracer) {
-  for (const double sigma : {1e-6, 1e-3, 1e-2}) {
+  // (At 1e-6 the path tracer's 16 spp of 32x32 pixels scatter about once in all, too few
+  // to compare with: measured at 64x64 it went from x8876 to x0.48.)
+  for (const double sigma : {1e-3, 1e-2}) {
     json scene = sphereScene();
     scene["material"]["base"] = {{"sigma_t", {sigma, sigma, sigma}},
                                  {"sigma_s", {0.9 * sigma, 0.9 * sigma, 0.9 * sigma}},
