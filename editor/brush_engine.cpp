@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <stdexcept>
@@ -212,8 +214,31 @@ DabResult BrushEngine::addPoints(const std::vector<glm::dvec3>& worldPoints) {
   Impl& m = *impl_;
   if (!m.inStroke) throw std::logic_error("BrushEngine::addPoints outside a stroke");
   std::vector<glm::dvec3> dabs;
-  for (const glm::dvec3& p : worldPoints) {
+  // A dab farther than its radius from the object's bounds paints nothing the object
+  // shows, yet the set grows a voxel tree wherever it lands (a point at y = 1e5 grew the
+  // set by gigabytes): such points are refused before any dab is applied.
+  Bounds reach = m.target.restBounds;
+  reach.min -= glm::dvec3(m.resolved.radiusRest);
+  reach.max += glm::dvec3(m.resolved.radiusRest);
+  for (std::size_t i = 0; i < worldPoints.size(); ++i) {
+    const glm::dvec3& p = worldPoints[i];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) throw InputError("points: must be finite");
+    const glm::dvec3 q = m.worldToRestPoint(p);
+    bool outside = false;
+    for (int a = 0; a < 3; ++a) outside = outside || q[a] < reach.min[a] || q[a] > reach.max[a];
+    if (outside && !reach.empty()) {
+      const auto text = [](const glm::dvec3& v) {
+        char buffer[96];
+        std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g, %.6g)", v.x, v.y, v.z);
+        return std::string(buffer);
+      };
+      throw InputError("points[" + std::to_string(i) + "]: " + text(p) +
+                       " is farther than the brush radius from the object, whose rest-space bounds are " +
+                       text(m.target.restBounds.min) + " .. " + text(m.target.restBounds.max) +
+                       "; a stroke must stay within its radius of the object");
+    }
+  }
+  for (const glm::dvec3& p : worldPoints) {
     if (!m.lastPoint)
       dabs.push_back(p);
     else

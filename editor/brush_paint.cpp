@@ -1,6 +1,7 @@
 // The brush engine's painting: dabs in index space and the per-voxel update of every mode
 // (formulas in brush_engine.h; the stroke paths and the history are in brush_engine.cpp).
 #include <algorithm>
+#include <cstdio>
 #include <cfloat>
 #include <cmath>
 #include <glm/geometric.hpp>
@@ -16,6 +17,9 @@ using namespace brush_detail;
 namespace {
 
 constexpr double kMaxDabVoxels = double(1 << 26);
+/// Voxel visits of one addPoints/addRays call: about 10-30 s of painting at the rate a
+/// smooth brush paints (the slowest mode), far beyond any hand-drawn stroke.
+constexpr double kMaxStrokeVoxelVisits = double(1 << 30);
 
 }  // namespace
 
@@ -227,6 +231,22 @@ void BrushEngine::Impl::applyDab(const glm::dvec3& centre, DabResult& out, Index
 }
 
 DabResult BrushEngine::Impl::applyDabs(const std::vector<glm::dvec3>& worldDabs, std::size_t missed) {
+  // The work is bounded before any of it is done: every dab visits its index box (twice
+  // with a mirror), so a long smooth stroke of large dabs could run for minutes.
+  // A single dab over its own limit is left to applyDab, which names that limit.
+  double visits = 0.0, largest = 0.0;
+  for (const glm::dvec3& p : worldDabs) {
+    const double voxels = sphereBox(worldToRestPoint(p), resolved.radiusRest).voxels();
+    visits += voxels;
+    largest = std::max(largest, voxels);
+  }
+  if (resolved.mirror) visits *= 2.0;
+  if (visits > kMaxStrokeVoxelVisits && largest <= kMaxDabVoxels) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.3g", visits);
+    throw InputError("radius: the stroke's " + std::to_string(worldDabs.size()) + " dabs would visit " + count +
+                     " voxels, more than the limit of 2^30; use a smaller radius or a shorter stroke");
+  }
   DabResult out;
   out.raysMissed = missed;
   raysMissed += missed;

@@ -487,6 +487,7 @@ PropagationResult GpuPropagator::execute(Mode mode, const PropagationOptions& op
     }
   }
   result.stepsRun = control.stepsRun;
+  result.capped = options.autoSteps && control.stopped == 0;
   result.tailScale = glm::dvec3(control.tailScaleR, control.tailScaleG, control.tailScaleB);
   timings_.steps = result.stepsRun;
   return result;

@@ -19,6 +19,21 @@ double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// Peak bytes of a frame on this backend: the host's material grid and step factors
+/// (estimateLpvBytes' first two terms), plus the device buffers, which lavapipe keeps in
+/// host memory: the voxelizer's nearest-triangle and coverage words, the cell coverage,
+/// the exit factors (8 floats), the reduced medium (2 vec4), the calibrated injection
+/// records and the propagator's five light fields (source, accumulated, two ping-pong
+/// tiles, tiled accumulated) and its factor texels. Measured peak RSS less a small
+/// grid's (sphere, --steps auto, lavapipe): 667 B a cell at 64^3.
+std::size_t vulkanLpvBytes(const GridFrame& frame) {
+  constexpr std::size_t kFloat = sizeof(float), kVec4 = 4 * kFloat;
+  constexpr std::size_t host = kFloat * (1 + 3 + 3 + 1) + kFloat * (8 * 3 + 3 * SSLPV_OBLIQUE_INTERVALS) + 1;
+  constexpr std::size_t device = 2 * kFloat + kFloat + 8 * kFloat + 2 * kVec4 + SSLPV_CALIBRATED_INJECTION_VEC4 * kVec4 +
+                                 SSLPV_FACTOR_VEC4_PER_CELL * kVec4;
+  return frame.cellCount() * (host + device) + 5 * std::size_t(lightFieldBytes(frame));
+}
+
 }  // namespace
 
 VulkanRenderer::VulkanRenderer(const Scene& scene, const VulkanDevice& device)
@@ -50,6 +65,7 @@ void VulkanRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, cons
 
 void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& report) {
   const GridFrame frame = makeGridFrame(object_.bounds(), settings.resolution);
+  requireLpvMemory(frame, vulkanLpvBytes(frame), "vulkan");
   const bool sameFrame = voxelizer_ && voxelizer_->frame().dims == frame.dims &&
                          voxelizer_->frame().origin == frame.origin && voxelizer_->frame().cellSize == frame.cellSize;
   if (!sameFrame) voxelizer_ = std::make_unique<GpuVoxelizer>(device_, frame);
@@ -60,6 +76,7 @@ void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& repo
   // propagation are built there, together with the resampled material.
   material_ = MaterialGrid{};
   material_.frame = frame;
+  material_.meanChord = meanChordLength(object_.mesh());
   material_.coverage = voxelizer_->readCoverage();
   cellCoverage_ = std::make_unique<Buffer>(uploadCellCoverage(device_, material_));
   propagator_.reset();
@@ -75,6 +92,7 @@ void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report)
     report.resampledCells = material_.frame.cellCount();
   }
   factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
+  report.opticalThickness = factors_.opticalThickness;
   exitFactors_ = std::make_unique<Buffer>(uploadExitFactors(device_, factors_, material_.frame));
   reducedMedium_ = factors_.scheme == LpvScheme::Calibrated
                        ? std::make_unique<Buffer>(uploadReducedMedium(device_, material_))

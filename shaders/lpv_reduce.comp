@@ -79,15 +79,28 @@ void main() {
     vec3 logShrink = vec3(control.logShrinkR, control.logShrinkG, control.logShrinkB);
     bool converged = k > SSLPV_CHEBYSHEV_RATE_WINDOW;
     vec3 omega;
+    vec3 markChange = vec3(control.markChangeR, control.markChangeG, control.markChangeB);
+    vec3 markTotal = vec3(control.markTotalR, control.markTotalG, control.markTotalB);
+    ivec3 sinceMark = ivec3(control.sinceMarkR, control.sinceMarkG, control.sinceMarkB);
     for (int ch = 0; ch < 3; ++ch) {
       omega[ch] = chebyshevOmega(k, rho[ch]);
       if (k > 1 && lastChange[ch] > 0.0 && change[ch] > 0.0)
         logShrink[ch] += (log(change[ch] / lastChange[ch]) - logShrink[ch]) / float(SSLPV_CHEBYSHEV_RATE_WINDOW);
+      const float chTotal = row[3][ch];
+      // StallWatch: the float floor, where the change stops halving and the total stays put.
+      if (sinceMark[ch] >= 0) {
+        if (sinceMark[ch] == 0 || change[ch] < 0.5 * markChange[ch]) {
+          markChange[ch] = change[ch];
+          markTotal[ch] = chTotal;
+          sinceMark[ch] = 1;
+        } else if (++sinceMark[ch] >= SSLPV_CHEBYSHEV_STALL_WINDOW) {
+          sinceMark[ch] = abs(chTotal - markTotal[ch]) < push.autoTolerance * abs(chTotal) ? -1 : 0;
+        }
+      }
       // chebyshevConverged(): the light still to come, the change times rate / (1 - rate)
       // at the larger of the theoretical and the observed shrink, under autoTolerance of
-      // the total, or the change float noise.
-      const float chTotal = row[3][ch];
-      if (!(chTotal > 0.0) || !(change[ch] > float(SSLPV_AUTO_STEP_NEGLIGIBLE) * chTotal)) continue;
+      // the total, or the change float noise, or the floor.
+      if (!(chTotal > 0.0) || !(change[ch] > float(SSLPV_AUTO_STEP_NEGLIGIBLE) * chTotal) || sinceMark[ch] < 0) continue;
       const float rate = max(chebyshevRate(rho[ch]), min(exp(logShrink[ch]), float(SSLPV_CHEBYSHEV_MAX_RHO)));
       if (!(change[ch] * rate / (1.0 - rate) < push.autoTolerance * chTotal)) converged = false;
     }
@@ -100,6 +113,15 @@ void main() {
     control.omegaR = omega.r;
     control.omegaG = omega.g;
     control.omegaB = omega.b;
+    control.markChangeR = markChange.r;
+    control.markChangeG = markChange.g;
+    control.markChangeB = markChange.b;
+    control.markTotalR = markTotal.r;
+    control.markTotalG = markTotal.g;
+    control.markTotalB = markTotal.b;
+    control.sinceMarkR = sinceMark.r;
+    control.sinceMarkG = sinceMark.g;
+    control.sinceMarkB = sinceMark.b;
     if (converged) control.stopped = 1;
     return;
   }

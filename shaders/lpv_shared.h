@@ -93,7 +93,16 @@ struct LpvStepPush {
   X(float, lastChangeB)             \
   X(float, logShrinkR)  /* running mean of log(change / last change) */ \
   X(float, logShrinkG)              \
-  X(float, logShrinkB)
+  X(float, logShrinkB)              \
+  X(float, markChangeR) /* the change and total where the stall window began */ \
+  X(float, markChangeG)             \
+  X(float, markChangeB)             \
+  X(float, markTotalR)              \
+  X(float, markTotalG)              \
+  X(float, markTotalB)              \
+  X(int, sinceMarkR)    /* iterates since then */ \
+  X(int, sinceMarkG)                \
+  X(int, sinceMarkB)
 
 struct LpvControl {
   SSLPV_LPV_CONTROL_FIELDS(SSLPV_DECLARE_FIELD)
@@ -131,7 +140,7 @@ struct LpvItem {
 }  // namespace sslpv::gpu
 static_assert(sizeof(sslpv::gpu::LpvStepPush) == 13 * 4, "LpvStepPush must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::LpvStepPush, autoTolerance) == 6 * 4, "LpvStepPush field order");
-static_assert(sizeof(sslpv::gpu::LpvControl) == 25 * 4, "LpvControl must be 4-byte scalars only");
+static_assert(sizeof(sslpv::gpu::LpvControl) == 34 * 4, "LpvControl must be 4-byte scalars only");
 static_assert(offsetof(sslpv::gpu::LpvControl, accumulatedPowerR) == 2 * 4, "LpvControl field order");
 static_assert(sizeof(sslpv::gpu::LpvItem) == 4 * 4, "LpvItem is one uvec4");
 #endif

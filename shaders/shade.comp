@@ -151,7 +151,7 @@ int singleScatteringGroups(vec3 extinction, out int group[3], out float referenc
     }
     high = sigma;
     group[ch] = groups - 1;
-    reference[groups - 1] = sqrt(low * high);
+    reference[groups - 1] = sqrt(low) * sqrt(high);  // low * high overflows float above ~1.8e19
   }
   return groups;
 }
@@ -166,8 +166,10 @@ vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
   const int groups = singleScatteringGroups(extinction0, group, reference);
   const uint views = uint(push.gridDims.w);
   vec3 sum = vec3(0.0);
+  // At least one sample spacing per grid extent, as singleScatteredRadiance.
+  const float extent = cellSize * float(max(grid.dims.x, max(grid.dims.y, grid.dims.z)));
   for (int gi = 0; gi < groups; ++gi) {
-    const float sigma0 = reference[gi];
+    const float sigma0 = max(reference[gi], 1.0 / extent);
     vec3 opticalDepth = vec3(0.0), lastSigma = extinction0;
     float lastS = 0.0;
     for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
@@ -176,7 +178,7 @@ vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
       const vec3 q = p + s * into;
       vec3 extinction, scattering;
       if (!reducedMediumAt(grid, q, extinction, scattering)) break;
-      opticalDepth += 0.5 * (extinction + lastSigma) * (s - lastS);
+      opticalDepth += (0.5 * extinction + 0.5 * lastSigma) * (s - lastS);  // the sum may overflow
       lastS = s;
       lastSigma = extinction;
       vec3 arriving = vec3(0.0);

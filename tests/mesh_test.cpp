@@ -155,15 +155,71 @@ TEST(Mesh, ObjFileLoadsTriangulatedAndClosed) {
   EXPECT_NEAR(signedVolume(mesh), 1.0, 1e-6);
 }
 
-TEST(Mesh, InsideOutObjIsAcceptedWithNegativeVolume) {
+// An inside-out file rendered black (the shadow maps and shading take "outside" from the
+// winding): it is accepted and turned outward.
+TEST(Mesh, InsideOutObjIsReorientedOutward) {
   test::TempDir dir;
   std::string text = kCubeVertices;
   // The same faces with reversed winding.
   text += "f 3 7 5 1\nf 6 8 4 2\nf 5 6 2 1\nf 4 8 7 3\nf 2 4 3 1\nf 7 8 6 5\n";
   test::writeText(dir / "inverted.obj", text);
   TriangleMesh mesh = loadMesh(fileSource(dir / "inverted.obj"), {});
-  EXPECT_NEAR(signedVolume(mesh), -1.0, 1e-6);
+  EXPECT_NEAR(signedVolume(mesh), 1.0, 1e-6);
   EXPECT_NO_THROW(requireClosedMesh(mesh));
+}
+
+/// Every triangle of a closed mesh faces away from `inside` (a point of a convex part).
+std::size_t trianglesFacing(const TriangleMesh& mesh, const glm::dvec3& inside, double sign) {
+  std::size_t count = 0;
+  for (const glm::uvec3& t : mesh.triangles) {
+    const glm::dvec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
+    if (sign * glm::dot(glm::cross(b - a, c - a), (a + b + c) / 3.0 - inside) > 0.0) ++count;
+  }
+  return count;
+}
+
+TriangleMesh boxMesh(const glm::dvec3& lo, const glm::dvec3& hi) {
+  MeshSource box;
+  box.kind = MeshSource::Kind::Box;
+  box.boxMin = lo;
+  box.boxMax = hi;
+  return loadMesh(box, {});
+}
+
+TriangleMesh loadInMemory(const TriangleMesh& mesh) {
+  MeshSource source;
+  source.kind = MeshSource::Kind::InMemory;
+  source.mesh = std::make_shared<const TriangleMesh>(mesh);
+  return loadMesh(source, {});
+}
+
+// One reversed face of six made a box 35 % darker: faces are made consistent with their
+// neighbours across shared edges, then outward by the signed volume.
+TEST(Mesh, AReversedFaceIsTurnedToAgreeWithItsNeighbours) {
+  TriangleMesh mesh = boxMesh({0, 0, 0}, {2, 2, 2});
+  std::swap(mesh.triangles[4].y, mesh.triangles[4].z);
+  std::swap(mesh.triangles[5].y, mesh.triangles[5].z);
+  ASSERT_EQ(trianglesFacing(mesh, glm::dvec3(1.0), 1.0), 10u);
+  const TriangleMesh fixed = loadInMemory(mesh);
+  EXPECT_EQ(trianglesFacing(fixed, glm::dvec3(1.0), 1.0), 12u);
+  EXPECT_DOUBLE_EQ(signedVolume(fixed), 8.0);
+}
+
+// A hollow object: the cavity's surface faces into the cavity (away from the material),
+// which a part's own signed volume alone would get wrong; nesting parity keeps it, and
+// flips it when it faces the material.
+TEST(Mesh, ACavityFacesIntoTheCavity) {
+  TriangleMesh outer = boxMesh({0, 0, 0}, {4, 4, 4});
+  const TriangleMesh inner = boxMesh({1, 1, 1}, {3, 3, 3});
+  const auto base = unsigned(outer.positions.size());
+  outer.positions.insert(outer.positions.end(), inner.positions.begin(), inner.positions.end());
+  for (glm::uvec3 t : inner.triangles) outer.triangles.emplace_back(t.x + base, t.z + base, t.y + base);  // into the cavity
+  const TriangleMesh kept = loadInMemory(outer);
+  EXPECT_EQ(kept.triangles, outer.triangles);
+  EXPECT_DOUBLE_EQ(signedVolume(kept), 64.0 - 8.0);
+  for (std::size_t i = 12; i < 24; ++i) std::swap(outer.triangles[i].y, outer.triangles[i].z);  // toward the material
+  const TriangleMesh fixed = loadInMemory(outer);
+  EXPECT_DOUBLE_EQ(signedVolume(fixed), 64.0 - 8.0);
 }
 
 TEST(Mesh, PlyFileLoads) {

@@ -214,6 +214,48 @@ TEST(PaintCli, BadStrokeFilesExit2WithOneLineNamingTheKeyAndLeaveTheOutputUntouc
   }
 }
 
+/// Runs `sslpv paint` on sceneJson() with `strokes`; the output must not appear.
+RunResult paintRefused(const json& strokes) {
+  Files f;
+  writeText(f.scene, sceneJson().dump());
+  writeText(f.strokes, strokes.dump());
+  const RunResult run = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", f.output.string()});
+  EXPECT_FALSE(fs::exists(f.output));
+  EXPECT_EQ(std::count(run.stderrText.begin(), run.stderrText.end(), '\n'), 1) << run.stderrText;
+  return run;
+}
+
+// A stroke ending far outside the object grew the set's voxel tree by ~190 MB/s to
+// gigabytes (or died in pthread_create): such a point is refused, by index, before any dab.
+TEST(PaintCli, AStrokePointFarOutsideTheObjectIsRefusedByItsIndex) {
+  const RunResult run = paintRefused(
+      {{"strokes",
+        {{{"channel", "sigma_t"},
+          {"mode", "set"},
+          {"value", 2},
+          {"radius", 1},
+          {"points", {{1, 2, 3}, {1, 4, 3}, {1, 1e5, 3}}}}}}});
+  EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+  EXPECT_NE(run.stderrText.find("strokes[0].points[2]: (1, 100000, 3) is farther than the brush radius from the object"),
+            std::string::npos)
+      << run.stderrText;
+}
+
+// Points near the object but a stroke whose dabs would visit more than 2^30 voxels in all
+// (here ~200 segments of 8 dabs of ~10^6 voxels each) is refused before it starts.
+TEST(PaintCli, AStrokeWhoseTotalWorkIsTooLargeIsRefusedBeforeItStarts) {
+  Files f;
+  writeText(f.scene, sceneJson().dump());
+  const glm::dmat4 restToWorld = loadScene(f.scene).transform.matrix();
+  json points = json::array();
+  for (int i = 0; i < 200; ++i) points.push_back(worldPoint(restToWorld, glm::dvec3(i % 2 ? 4.0 : -4.0, 0.0, 0.0)));
+  const RunResult run =
+      paintRefused({{"strokes", {{{"mode", "smooth"}, {"radius", 8}, {"points", points}}}}});
+  EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+  EXPECT_NE(run.stderrText.find("strokes[0].radius: the stroke's"), std::string::npos) << run.stderrText;
+  EXPECT_NE(run.stderrText.find("more than the limit of 2^30"), std::string::npos) << run.stderrText;
+}
+
 TEST(PaintCli, BadOutputOrMissingStrokeFileExit2) {
   Files f;
   writeText(f.scene, sceneJson().dump());

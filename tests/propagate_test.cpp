@@ -491,6 +491,51 @@ TEST(Chebyshev, AutoStepsReachTheConvergedLatticeInFewerSteps) {
   }
 }
 
+// A white medium 100 mean free paths a cell (survival 1, retention -1): the iterates
+// reach their float floor (the change stalls near 1e-4 of the total) long before the
+// usual stop, which then never came: every such run went to the 10000-step cap. The
+// floor now stops it, uncapped, within the tolerance of its converged light.
+TEST(Chebyshev, AWhiteDenseCubeStopsAtItsFloatFloorInsteadOfTheCap) {
+  Ball cube;
+  cube.material = uniformMaterial(32, glm::vec3(100.0f), glm::vec3(100.0f), 0.0f);
+  cube.injected.resize(cube.material.frame);
+  for (int y = 4; y < 28; y += 3)
+    for (int z = 4; z < 28; z += 3) putLobe(cube.injected, 1, y, z, glm::vec3(1, 0, 0), 1.0f);
+  const StepFactors factors = computeStepFactors(cube.material, LpvScheme::Calibrated, 1.4);
+  PropagationOptions options;
+  options.autoSteps = true;
+  options.chebyshev = true;
+  const LobeRun fast = propagateBall(cube, factors, options);
+  // The same semi-iteration held to a 1000 times tighter stop: its fixed point (the
+  // plain steps' clamp of negative light, which retention -1 makes, leaves theirs ~10 %
+  // brighter here, with or without the floor).
+  PropagationOptions tight = options;
+  tight.autoTolerance = 1e-6;
+  tight.maxAutoSteps = 100000;
+  const LobeRun converged = propagateBall(cube, factors, tight);
+  std::printf("semi-iteration %d steps, held to 1e-6 %d steps, %.2e apart\n", fast.result.stepsRun,
+              converged.result.stepsRun, relativeL1(fast.accumulated, converged.accumulated));
+  EXPECT_FALSE(fast.result.capped);
+  EXPECT_LT(fast.result.stepsRun, 2000);
+  EXPECT_LT(relativeL1(fast.accumulated, converged.accumulated), 2e-3);
+}
+
+// Reaching the cap is reported, not silent: both forms of --steps auto set `capped`.
+TEST(Chebyshev, ReachingTheAutoStepCapIsReported) {
+  const Ball ball = ballCase(18, true, false, 3u);
+  const StepFactors factors = computeStepFactors(ball.material, LpvScheme::Calibrated, 1.4);
+  for (const bool chebyshev : {true, false}) {
+    PropagationOptions options;
+    options.autoSteps = true;
+    options.chebyshev = chebyshev;
+    EXPECT_FALSE(propagateBall(ball, factors, options).result.capped) << chebyshev;
+    options.maxAutoSteps = SSLPV_CHEBYSHEV_PROBE_STEPS + 4;
+    const LobeRun capped = propagateBall(ball, factors, options);
+    EXPECT_TRUE(capped.result.capped) << chebyshev;
+    EXPECT_EQ(capped.result.stepsRun, options.maxAutoSteps) << chebyshev;
+  }
+}
+
 TEST(Chebyshev, ADarkGridStopsAfterOneProbeStep) {
   // No injected light: the first step and one probe step, whose predecessor held
   // nothing, and the accumulated light stays zero.

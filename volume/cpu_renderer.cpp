@@ -71,6 +71,8 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
   if (dirty_.dirty(Stage::Voxelize)) {
     material_ = MaterialGrid{};
     material_.frame = makeGridFrame(object_.bounds(), settings.resolution);
+    requireLpvMemory(material_.frame, estimateLpvBytes(material_.frame), "cpu");
+    material_.meanChord = meanChordLength(object_.mesh());
     // The twin of the GPU voxelizer, so both backends see the same occupancy.
     material_.coverage = voxelizeCoverageParity(object_.mesh(), material_.frame);
     report.frame = material_.frame;
@@ -90,6 +92,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
       termCache_.valid = false;
     }
     factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
+    report.opticalThickness = factors_.opticalThickness;
     report.activeCells = 0;
     for (unsigned char a : factors_.active) report.activeCells += a;
     report.times.resample = watch.lapMs();

@@ -46,6 +46,9 @@ std::string formatTimings(const RenderReport& r) {
                 r.backend.c_str(), r.frame.dims.x, r.frame.dims.y, r.frame.dims.z, r.frame.cellSize, r.activeCells,
                 r.propagation.stepsRun, r.triangles);
   out << line;
+  if (r.propagation.capped)
+    out << "warning: --steps auto stopped at its cap of " << r.propagation.stepsRun
+        << " steps before converging: the light is not converged\n";
   out << "stage                 ms\n";
   auto row = [&](const char* name, double ms, bool cached) {
     if (cached)

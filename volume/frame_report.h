@@ -41,6 +41,8 @@ struct RenderReport {
   std::vector<ShadowMapStats> lights;
   InjectionStats injection;
   PropagationResult propagation;
+  /// StepFactors::opticalThickness of the last resampling (0: unknown or seed scheme).
+  glm::dvec3 opticalThickness{0.0};
 };
 
 /// Dirty flags of the frame's stages, following the data flow (docs/design.md §2): each change

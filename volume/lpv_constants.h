@@ -49,6 +49,11 @@
 // may use it.
 #define SSLPV_CHEBYSHEV_PROBE_STEPS 16
 #define SSLPV_CHEBYSHEV_RATE_WINDOW 8
+// The semi-iteration's floor: where a channel's change has not halved within this many
+// iterates and its total has moved by less than the tolerance over them, the iterates
+// differ by float rounding only (a sphere of albedo-1 medium at 100 mean free paths a
+// cell stalled at a change of 7e-5 of its total and ran into the step cap).
+#define SSLPV_CHEBYSHEV_STALL_WINDOW 64
 // Spectral radius estimates stay below 1 by this much (a ratio of 1 is float noise).
 #define SSLPV_CHEBYSHEV_MAX_RHO (1.0 - 1e-7)
 

@@ -3,23 +3,36 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/common.hpp>
+#include <fstream>
 #include <string>
 #include <unistd.h>
 
 #include "volume/error.h"
+#include "volume/lpv_constants.h"
 #include "volume/mesh.h"
 
 namespace sslpv {
 
-namespace {
-// The CPU backend refuses grids beyond this share of physical memory, with a clear
-// message, rather than dying in the allocator.
-std::size_t physicalMemoryBytes() {
-  long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+std::size_t availableMemoryBytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  std::size_t kib = 0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024;
+  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
   if (pages <= 0 || pageSize <= 0) return std::size_t(8) << 30;
   return std::size_t(pages) * std::size_t(pageSize);
 }
-}  // namespace
+
+void requireLpvMemory(const GridFrame& frame, std::size_t bytes, const char* backend) {
+  const std::size_t have = availableMemoryBytes();
+  if (bytes <= have) return;
+  throw ResourceError("an LPV of " + std::to_string(frame.dims.x) + "x" + std::to_string(frame.dims.y) + "x" +
+                      std::to_string(frame.dims.z) + " cells needs about " + std::to_string(bytes >> 20) +
+                      " MiB on the " + backend + " backend, more than the " + std::to_string(have >> 20) +
+                      " MiB this machine has available; lower --grid / lpv.resolution");
+}
 
 void CellRange::include(const CellRange& other) {
   if (other.empty()) return;
@@ -46,7 +59,9 @@ CellRange cellsOverlapping(const GridFrame& frame, const Bounds& world) {
 }
 
 GridFrame makeGridFrame(const Bounds& objectBounds, int resolution) {
-  if (resolution < 2) throw InputError("LPV resolution must be at least 2, got " + std::to_string(resolution));
+  if (resolution < kMinLpvResolution)
+    throw InputError("--grid / lpv.resolution: must be at least " + std::to_string(kMinLpvResolution) +
+                     " (a cell for the object and a margin cell on each side), got " + std::to_string(resolution));
   if (objectBounds.empty()) throw InputError("the object has no extent");
   const glm::dvec3 extent = objectBounds.extent();
   const double longest = std::max({extent.x, extent.y, extent.z});
@@ -61,20 +76,26 @@ GridFrame makeGridFrame(const Bounds& objectBounds, int resolution) {
     frame.dims[a] = std::min(cells, resolution);
     frame.origin[a] = center[a] - 0.5 * frame.dims[a] * frame.cellSize;
   }
-  const std::size_t need = estimateLpvBytes(frame);
-  const std::size_t have = physicalMemoryBytes();
-  if (need > have / 10 * 8)
-    throw ResourceError("an LPV of " + std::to_string(frame.dims.x) + "x" + std::to_string(frame.dims.y) + "x" +
-                        std::to_string(frame.dims.z) + " cells needs " + std::to_string(need >> 20) +
-                        " MiB, more than 80% of this machine's " + std::to_string(have >> 20) +
-                        " MiB; lower the resolution");
   return frame;
 }
 
 std::size_t estimateLpvBytes(const GridFrame& frame) {
-  // material: coverage + sigmaT + sigmaS + g + two 3-channel step factors; light: three SH grids.
-  const std::size_t perCell = sizeof(float) * (1 + 3 + 3 + 1 + 6) + 3 * ShGrid::kPlanes * sizeof(float);
-  return frame.cellCount() * perCell;
+  // Per cell, what is held while the propagation runs (its peak; the step factors'
+  // temporaries are gone by then), in bytes:
+  //  - MaterialGrid: coverage 4, sigmaT 12, sigmaS 12, g 4;
+  //  - StepFactors (calibrated): dc, linear, exitGain, reducedAlbedo, retention,
+  //    injectionDepth, freshGain and conductance 3 floats each, obliqueGain
+  //    3 x SSLPV_OBLIQUE_INTERVALS floats, active 1;
+  //  - ShGrids: the injected light and the accumulated light kept by the renderer, and
+  //    propagate()'s working field and next step, kPlanes floats each;
+  //  - the semi-iteration of --steps auto: source, current and older c0, 3 floats each.
+  // Measured peak RSS less a small grid's (sphere, --steps auto): 371 B a cell at 64^3.
+  constexpr std::size_t kFloat = sizeof(float);
+  constexpr std::size_t material = kFloat * (1 + 3 + 3 + 1);
+  constexpr std::size_t factors = kFloat * (8 * 3 + 3 * SSLPV_OBLIQUE_INTERVALS) + 1;
+  constexpr std::size_t light = 4 * ShGrid::kPlanes * kFloat;
+  constexpr std::size_t semiIteration = 3 * 3 * kFloat;
+  return frame.cellCount() * (material + factors + light + semiIteration);
 }
 
 void ShGrid::resize(const GridFrame& f) {

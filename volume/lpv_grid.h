@@ -51,17 +51,36 @@ struct CellRange {
 /// The cells of `frame` whose box overlaps `world` (empty when none does).
 CellRange cellsOverlapping(const GridFrame& frame, const Bounds& world);
 
+/// The smallest resolution that holds the object: one cell for it and a margin cell on
+/// each side (at 2 the object lay in the margin only, and every pixel came out black).
+inline constexpr int kMinLpvResolution = 3;
+
 /// Frame whose longest axis holds `resolution` cubic cells and that covers `bounds`
 /// plus a margin of one cell on every side (so boundary cells always have neighbours
-/// outside the object). Throws ResourceError when the grids would not fit in memory.
+/// outside the object). Throws InputError below kMinLpvResolution. The renderers check
+/// memory themselves (requireLpvMemory), each with its own layout.
 GridFrame makeGridFrame(const Bounds& objectBounds, int resolution);
 
-/// Bytes the CPU backend needs for a frame (material + three SH grids).
+/// Peak bytes the CPU backend holds for a frame: the sum of its per-cell arrays while it
+/// propagates (lpv_grid.cpp lists them).
 std::size_t estimateLpvBytes(const GridFrame& frame);
+
+/// Memory the system can give a new allocation without swapping: MemAvailable from
+/// /proc/meminfo (physical memory where that is missing).
+std::size_t availableMemoryBytes();
+
+/// Throws ResourceError naming the grid, `backend` and the estimate when `bytes` exceed
+/// availableMemoryBytes(): refused before allocating, rather than growing until the
+/// machine runs out.
+void requireLpvMemory(const GridFrame& frame, std::size_t bytes, const char* backend);
 
 /// The material and occupancy of every LPV cell.
 struct MaterialGrid {
   GridFrame frame;
+  /// The object's mean chord 4 V / S (Cauchy), set by the renderers from the mesh: with
+  /// σt' it gives the optical thickness the calibrated scheme corrects for (0: unknown,
+  /// no correction).
+  double meanChord = 0.0;
   std::vector<float> coverage;          ///< fraction of the cell inside the mesh, [0,1]
   std::vector<glm::vec3> sigmaT;        ///< box-filtered over the cell, per scene unit
   std::vector<glm::vec3> sigmaS;

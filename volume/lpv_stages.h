@@ -129,6 +129,9 @@ struct PropagationResult {
   /// accumulated light for the steps not run, r/(1-r); 0 when none was added.
   glm::dvec3 tailScale{0.0};
   std::vector<StepEnergy> energy;  ///< one entry per step when recordEnergy
+  /// Auto steps: the run reached maxAutoSteps before its stop rule held, so the light is
+  /// not converged (reported by the CLI and in the timing table).
+  bool capped = false;
 };
 
 /// Per-cell transport factors of one step, derived from the material grid. Seed scheme:
@@ -171,6 +174,10 @@ struct StepFactors {
   /// The boundary's relative index, which turns a sample's refracted direction back into
   /// its incidence angle for the oblique-entry gain (incidentCosineSquared).
   double ior = 1.0;
+  /// Calibrated scheme with a known mean chord: per channel, the object's optical
+  /// thickness, its mean chord times the coverage-weighted mean σt' of its cells (0 when
+  /// unknown). Below a few mean free paths the lattice's diffusion does not describe it.
+  glm::dvec3 opticalThickness{0.0};
   std::vector<unsigned char> active;  ///< coverage > 0 and not on the outer ring
   /// Per (y, z) row: does it hold any active cell? Rows without one never hold light and
   /// are skipped, so cost follows the object's cells rather than its bounding box.

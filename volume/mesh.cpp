@@ -1,9 +1,8 @@
 #include "volume/mesh.h"
 
-// Orientation note for consumers: loadMesh keeps the winding the file has. Primitives are
-// counter-clockwise seen from outside, but a file may be consistently inside-out
-// (signedVolume < 0); that is accepted, so code that needs "outside" must decide it
-// geometrically (ray parity, |signedVolume|), never from the triangle winding.
+// Orientation note for consumers: loadMesh returns closed meshes wound counter-clockwise
+// seen from outside. A file that is inside-out or has some faces reversed is reoriented
+// (orientOutward) with a warning on stderr; meshes with holes keep the winding they have.
 
 #include <tbb/parallel_sort.h>
 
@@ -18,6 +17,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <glm/geometric.hpp>
 #include <glm/vector_relational.hpp>
 #include <limits>
@@ -350,6 +350,127 @@ TopologyDetails analyze(const TriangleMesh& mesh) {
   return details;
 }
 
+/// Does the ray o + t d, t > 0, cross triangle abc?
+bool rayCrosses(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
+                const glm::dvec3& c) {
+  // Möller–Trumbore, counting crossings ahead of the origin only.
+  const glm::dvec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+  const double det = glm::dot(e1, p);
+  if (std::abs(det) < 1e-300) return false;
+  const glm::dvec3 s = o - a;
+  const double u = glm::dot(s, p) / det;
+  if (u < 0.0 || u > 1.0) return false;
+  const glm::dvec3 q = glm::cross(s, e1);
+  const double v = glm::dot(d, q) / det;
+  if (v < 0.0 || u + v > 1.0) return false;
+  return glm::dot(e2, q) / det > 0.0;
+}
+
+/// Makes a closed mesh's winding consistent and outward: neighbours across each edge must
+/// traverse it in opposite directions (else one of them is flipped, found by a walk over
+/// the edge adjacency), and each connected part then faces outward, which its signed
+/// volume decides (positive, or negative for a part nested an odd number of times inside
+/// others: a cavity's surface faces into the cavity). The shadow maps and the shading take
+/// "outside" from the winding, so an inward or partly reversed mesh rendered black or dark.
+/// Returns how many triangles were flipped; a mesh with holes, non-manifold edges or no
+/// consistent orientation is left as it is (requireClosedMesh names the first two).
+std::size_t orientOutward(TriangleMesh& mesh) {
+  const std::size_t count = mesh.triangles.size();
+  struct HalfEdge {
+    std::uint64_t key;
+    std::uint32_t triangle;
+    bool forward;  ///< traversed from the smaller vertex index to the larger
+    bool operator<(const HalfEdge& o) const { return key < o.key || (key == o.key && triangle < o.triangle); }
+  };
+  std::vector<HalfEdge> halves;
+  halves.reserve(count * 3);
+  for (std::size_t t = 0; t < count; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      halves.push_back({(std::uint64_t(std::min(a, b)) << 32) | std::max(a, b), std::uint32_t(t), a < b});
+    }
+  tbb::parallel_sort(halves.begin(), halves.end());
+  // Each edge joins exactly two triangles; `same` says whether they traverse it alike.
+  struct Link {
+    std::uint32_t other;
+    bool same;
+  };
+  std::vector<std::array<Link, 3>> links(count);
+  std::vector<int> linkCount(count, 0);
+  for (std::size_t i = 0; i < halves.size(); i += 2) {
+    if (i + 1 >= halves.size() || halves[i + 1].key != halves[i].key ||
+        (i + 2 < halves.size() && halves[i + 2].key == halves[i].key))
+      return 0;
+    const HalfEdge& x = halves[i];
+    const HalfEdge& y = halves[i + 1];
+    const bool same = x.forward == y.forward;
+    if (linkCount[x.triangle] == 3 || linkCount[y.triangle] == 3) return 0;
+    links[x.triangle][std::size_t(linkCount[x.triangle]++)] = {y.triangle, same};
+    links[y.triangle][std::size_t(linkCount[y.triangle]++)] = {x.triangle, same};
+  }
+  // Flip relative to each component's first triangle.
+  constexpr int kUnset = -1;
+  std::vector<int> flip(count, kUnset), component(count, kUnset);
+  std::vector<std::uint32_t> firstOf, stack;
+  for (std::size_t seed = 0; seed < count; ++seed) {
+    if (flip[seed] != kUnset) continue;
+    const int id = int(firstOf.size());
+    firstOf.push_back(std::uint32_t(seed));
+    flip[seed] = 0;
+    component[seed] = id;
+    stack.assign(1, std::uint32_t(seed));
+    while (!stack.empty()) {
+      const std::uint32_t t = stack.back();
+      stack.pop_back();
+      for (int k = 0; k < linkCount[t]; ++k) {
+        const Link& link = links[t][std::size_t(k)];
+        const int wanted = flip[t] ^ int(link.same);
+        if (flip[link.other] == kUnset) {
+          flip[link.other] = wanted;
+          component[link.other] = id;
+          stack.push_back(link.other);
+        } else if (flip[link.other] != wanted) {
+          return 0;  // not orientable (a one-sided surface): nothing consistent to restore
+        }
+      }
+    }
+  }
+  const auto corner = [&](std::size_t t, int k) { return glm::dvec3(mesh.positions[mesh.triangles[t][k]]); };
+  const Bounds bounds = mesh.bounds();
+  const glm::dvec3 ref = 0.5 * (bounds.min + bounds.max);
+  std::vector<double> volume(firstOf.size(), 0.0);
+  for (std::size_t t = 0; t < count; ++t) {
+    const double six = glm::dot(corner(t, 0) - ref, glm::cross(corner(t, 1) - ref, corner(t, 2) - ref));
+    volume[std::size_t(component[t])] += flip[t] ? -six : six;
+  }
+  // Nesting parity by a ray from a point on each part through the other parts. It costs
+  // parts × triangles, so beyond kMaxNestingParts every part counts as outermost.
+  constexpr std::size_t kMaxNestingParts = 64;
+  std::vector<bool> nested(firstOf.size(), false);
+  if (firstOf.size() > 1 && firstOf.size() <= kMaxNestingParts) {
+    const glm::dvec3 direction = glm::normalize(glm::dvec3(0.5773, 0.6168, 0.5350));
+    for (std::size_t c = 0; c < firstOf.size(); ++c) {
+      const std::size_t t0 = firstOf[c];
+      const glm::dvec3 origin = (corner(t0, 0) + corner(t0, 1) + corner(t0, 2)) / 3.0;
+      bool odd = false;
+      for (std::size_t t = 0; t < count; ++t)
+        if (std::size_t(component[t]) != c && rayCrosses(origin, direction, corner(t, 0), corner(t, 1), corner(t, 2)))
+          odd = !odd;
+      nested[c] = odd;
+    }
+  }
+  std::size_t flipped = 0;
+  for (std::size_t t = 0; t < count; ++t) {
+    const std::size_t c = std::size_t(component[t]);
+    const bool outward = (volume[c] > 0.0) != nested[c];
+    if ((flip[t] != 0) == outward) {
+      std::swap(mesh.triangles[t].y, mesh.triangles[t].z);
+      ++flipped;
+    }
+  }
+  return flipped;
+}
+
 }  // namespace
 
 TriangleMesh loadMesh(const MeshSource& source, const Transform& transform) {
@@ -374,6 +495,9 @@ TriangleMesh loadMesh(const MeshSource& source, const Transform& transform) {
                        " after the transform, outside the coordinate range " + coordinateRange());
     mesh.positions[i] = glm::vec3(world);
   }
+  if (const std::size_t flipped = orientOutward(mesh))
+    std::cerr << "sslpv: warning: " << mesh.name << ": " << flipped << " of " << mesh.triangles.size()
+              << " triangles faced inward or against their neighbours; reoriented them to face outward\n";
   return mesh;
 }
 
@@ -393,6 +517,15 @@ double signedVolume(const TriangleMesh& mesh) {
     sixTimesVolume += glm::dot(a, glm::cross(b, c));
   }
   return sixTimesVolume / 6.0;
+}
+
+double meanChordLength(const TriangleMesh& mesh) {
+  double area = 0.0;
+  for (const auto& tri : mesh.triangles) {
+    const glm::dvec3 a(mesh.positions[tri.x]), b(mesh.positions[tri.y]), c(mesh.positions[tri.z]);
+    area += 0.5 * glm::length(glm::cross(b - a, c - a));
+  }
+  return area > 0.0 ? 4.0 * std::abs(signedVolume(mesh)) / area : 0.0;
 }
 
 void requireClosedMesh(const TriangleMesh& mesh) {

@@ -52,4 +52,8 @@ void requireClosedMesh(const TriangleMesh& mesh);
 /// Signed enclosed volume (positive for outward-facing triangles).
 double signedVolume(const TriangleMesh& mesh);
 
+/// Mean length of the chords of uniformly random lines through a closed mesh (Cauchy's
+/// formula, 4 V / S); 0 for an empty mesh.
+double meanChordLength(const TriangleMesh& mesh);
+
 }  // namespace sslpv

@@ -8,6 +8,7 @@
 #include <xmmintrin.h>
 
 #include <algorithm>
+#include <glm/vector_relational.hpp>
 #include <limits>
 #include <cmath>
 #include <type_traits>
@@ -423,14 +424,39 @@ namespace {
 /// `tolerance` of its total, or the change is float noise. No tail is added: unlike the
 /// plain steps' geometric tail, the estimate is only a bound. lpv_reduce.comp applies
 /// the same rule.
-bool chebyshevConverged(const ChebyshevSums& sums, const glm::dvec3& rate, double tolerance) {
+bool chebyshevConverged(const ChebyshevSums& sums, const glm::dvec3& rate, double tolerance, const glm::bvec3& stalled) {
   for (int ch = 0; ch < 3; ++ch) {
     const double total = sums.total[ch], change = sums.change[ch];
-    if (!(total > 0.0) || !(change > SSLPV_AUTO_STEP_NEGLIGIBLE * total)) continue;
+    if (!(total > 0.0) || !(change > SSLPV_AUTO_STEP_NEGLIGIBLE * total) || stalled[ch]) continue;
     if (!(change * rate[ch] / (1.0 - rate[ch]) < tolerance * total)) return false;
   }
   return true;
 }
+
+/// Per channel, whether the semi-iteration has reached its float floor
+/// (SSLPV_CHEBYSHEV_STALL_WINDOW): the change has not halved over the window while the
+/// total moved by under `tolerance` of itself. There the rate estimate tends to 1 (the
+/// change no longer shrinks) and the usual stop would never come. A channel at its floor
+/// stays there (sinceMark -1). lpv_reduce.comp keeps the same marks in its control record.
+struct StallWatch {
+  glm::dvec3 markChange{0.0}, markTotal{0.0};
+  glm::ivec3 sinceMark{0};
+  glm::bvec3 update(const ChebyshevSums& sums, double tolerance) {
+    for (int ch = 0; ch < 3; ++ch) {
+      const double change = sums.change[ch], total = sums.total[ch];
+      if (sinceMark[ch] < 0) continue;
+      if (sinceMark[ch] == 0 || change < 0.5 * markChange[ch]) {
+        markChange[ch] = change;
+        markTotal[ch] = total;
+        sinceMark[ch] = 1;
+      } else if (++sinceMark[ch] >= SSLPV_CHEBYSHEV_STALL_WINDOW) {
+        // At the floor, or slow progress (a new window).
+        sinceMark[ch] = std::abs(total - markTotal[ch]) < tolerance * std::abs(total) ? -1 : 0;
+      }
+    }
+    return glm::lessThan(sinceMark, glm::ivec3(0));
+  }
+};
 
 /// Runs the semi-iteration for x = (I - T)^-1 y, y the light of the first step (in
 /// `field`, which ends holding the last iterate), adding x - y to `accumulated`, which
@@ -487,6 +513,8 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   const glm::dvec3 rate(chebyshevRate(rho.x), chebyshevRate(rho.y), chebyshevRate(rho.z));
   // The observed shrink per iterate: a running mean of log(change / last change).
   glm::dvec3 lastChange(0.0), logShrink(0.0);
+  StallWatch stall;
+  bool converged = dark;
   for (int k = 1; result.stepsRun < maxSteps && !dark; ++k) {
     glm::vec3 omega(1.0f);
     for (int ch = 0; ch < 3; ++ch) omega[ch] = float(chebyshevOmega(k - 1, rho[ch]));
@@ -499,8 +527,13 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
       effective[ch] = std::max(rate[ch], std::min(std::exp(logShrink[ch]), SSLPV_CHEBYSHEV_MAX_RHO));
     }
     lastChange = total.change;
-    if (k > SSLPV_CHEBYSHEV_RATE_WINDOW && chebyshevConverged(total, effective, options.autoTolerance)) break;
+    const glm::bvec3 stalled = stall.update(total, options.autoTolerance);
+    if (k > SSLPV_CHEBYSHEV_RATE_WINDOW && chebyshevConverged(total, effective, options.autoTolerance, stalled)) {
+      converged = true;
+      break;
+    }
   }
+  result.capped = !converged;
   for (int ch = 0; ch < 3; ++ch) {
     float* sum = accumulated.plane(ch, 0);
     for (std::size_t i = 0; i < current[ch].size(); ++i) sum[i] += current[ch][i] - source[ch][i];
@@ -608,6 +641,7 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
         result.tailScale = decision.tailScale;
         break;
       }
+      result.capped = result.stepsRun >= maxSteps;
     }
   }
   return result;

@@ -77,7 +77,7 @@ int singleScatteringGroups(const glm::dvec3& extinction, int group[3], double re
     }
     high = sigma;
     group[ch] = groups - 1;
-    reference[groups - 1] = std::sqrt(low * high);
+    reference[groups - 1] = std::sqrt(low) * std::sqrt(high);  // as shade.comp, whose float product overflows
   }
   return groups;
 }
@@ -95,8 +95,14 @@ glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vecto
   double reference[3];
   const int groups = singleScatteringGroups(surface.extinction, group, reference);
   glm::dvec3 sum(0.0);
+  // The samples sit at -log(1 - u) / σ0 (any σ0 > 0 is the same integral, weighted by
+  // exp(σ0 s) / σ0); in an optically thin object spacing them by the mean free path put
+  // every one beyond the object and the term read 0. Spacing them by at most the grid's
+  // extent keeps ~60 % of them inside.
+  const GridFrame& f = material.frame;
+  const double extent = cellSize * std::max({f.dims.x, f.dims.y, f.dims.z});
   for (int gi = 0; gi < groups; ++gi) {
-    const double sigma0 = reference[gi];
+    const double sigma0 = std::max(reference[gi], 1.0 / extent);
     glm::dvec3 opticalDepth(0.0), lastSigma = surface.extinction;
     double lastS = 0.0;
     for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
