@@ -102,13 +102,14 @@ int texelThrough(uint v, vec3 q, out float along) {
 
 // Twin of the EntryTexel castShadowMap writes (volume/shadow_map.cpp) from a texel record
 // of view v: E T cos θi / cos θt (0 for a miss), the hit's distance along the texel ray,
-// and cos θi / cos θt.
-void entryOf(uint v, int record, out vec3 irradiance, out float distance, out float pathScale) {
+// cos θi / cos θt, and ∇P = −n / cos θt.
+void entryOf(uint v, int record, out vec3 irradiance, out float distance, out float pathScale, out vec3 gradient) {
   const GpuShadowView view = shadowViews[v];
   const GpuFluxSample texel = shadowSamples[record];
   irradiance = vec3(0.0);
   distance = 0.0;
   pathScale = 0.0;
+  gradient = vec3(0.0);
   if (texel.positionValid.w == 0.0) return;
   const bool orthographic = view.origin.w == SSLPV_SHADOW_ORTHOGRAPHIC;
   const vec3 toHit = texel.positionValid.xyz - view.origin.xyz;
@@ -122,97 +123,94 @@ void entryOf(uint v, int record, out vec3 irradiance, out float distance, out fl
   const float across = orthographic ? view.right.w * view.right.w
                                     : view.right.w * cosAxis * cosAxis * cosAxis * distance * distance;
   pathScale = cosT > 0.0 ? cosI / cosT : 0.0;
+  gradient = cosT > 0.0 ? -texel.normal.xyz / cosT : vec3(0.0);
   irradiance = texel.flux.rgb * (pathScale / across);
 }
 
-// Twin of singleScatteringGroups (volume/single_scattering.cpp): channels sorted by
-// σt', a new group wherever one exceeds SSLPV_SINGLE_SCATTERING_GROUP_SPREAD times its
-// group's smallest; the group's samples are spaced for the geometric mean of its extremes.
-int singleScatteringGroups(vec3 extinction, out int group[3], out float reference[3]) {
-  int order[3] = int[3](0, 1, 2);
-  for (int a = 0; a < 2; ++a)
-    for (int b = 0; b < 2 - a; ++b)
-      if (extinction[order[b + 1]] < extinction[order[b]]) {
-        const int t = order[b];
-        order[b] = order[b + 1];
-        order[b + 1] = t;
-      }
-  int groups = 0;
-  float low = 0.0, high = 0.0;
-  reference = float[3](0.0, 0.0, 0.0);
-  group = int[3](-1, -1, -1);
-  for (int k = 0; k < 3; ++k) {
-    const int ch = order[k];
-    const float sigma = extinction[ch];
-    if (!(sigma > 0.0)) continue;
-    if (groups == 0 || sigma > float(SSLPV_SINGLE_SCATTERING_GROUP_SPREAD) * low) {
-      low = sigma;
-      ++groups;
-    }
-    high = sigma;
-    group[ch] = groups - 1;
-    reference[groups - 1] = sqrt(low) * sqrt(high);  // low * high overflows float above ~1.8e19
+// Twin of meanDecay (volume/single_scattering.cpp): the mean of e^{-x u} over u in [0, 1].
+float meanDecay(float x) { return abs(x) < 1e-2 ? 1.0 - x * (0.5 - x / 6.0) : (1.0 - exp(-x)) / x; }
+
+// Twin of exponentialSegment (volume/single_scattering.cpp): ∫_a^b exp(−(c + r s)) ds.
+float exponentialSegment(float c, float r, float a, float b) {
+  if (!(b > a)) return 0.0;
+  const float x = r * (b - a);
+  return x >= 0.0 ? exp(-(c + r * a)) * (b - a) * meanDecay(x) : exp(-(c + r * b)) * (b - a) * meanDecay(-x);
+}
+
+// Twin of singleScatteringIntegral (volume/single_scattering.cpp); `end` < 0 stands for ∞.
+float singleScatteringIntegral(float sigma, float p0, float k, float end) {
+  if (!(sigma > 0.0) || end == 0.0) return 0.0;
+  const bool infinite = end < 0.0;
+  if (p0 < 0.0) {
+    if (k <= 0.0) return infinite ? 1.0 / sigma : exponentialSegment(0.0, sigma, 0.0, end);
+    const float s0 = -p0 / k;
+    if (!infinite && end <= s0) return exponentialSegment(0.0, sigma, 0.0, end);
+    const float rest = infinite ? exp(-sigma * s0) / (sigma * (1.0 + k))
+                                : exponentialSegment(-sigma * k * s0, sigma * (1.0 + k), s0, end);
+    return exponentialSegment(0.0, sigma, 0.0, s0) + rest;
   }
-  return groups;
+  if (k < 0.0) end = infinite ? p0 / -k : min(end, p0 / -k);
+  else if (infinite) return exp(-sigma * p0) / (sigma * (1.0 + k));
+  return exponentialSegment(sigma * p0, sigma * (1.0 + k), 0.0, end);
+}
+
+// Twin of viewRayExit (volume/single_scattering.cpp); -1 for ∞.
+float viewRayExit(CellGrid grid, vec3 p, vec3 into, float extinction) {
+  const int across = max(grid.dims.x, max(grid.dims.y, grid.dims.z));
+  const int steps = int(min(float(across), ceil(float(SSLPV_SINGLE_SCATTERING_EXIT_DEPTH) / (extinction * grid.cellSize))));
+  for (int i = 1; i <= steps; ++i) {
+    const ivec3 c = ivec3(floor((p + (float(i) * grid.cellSize) * into - grid.origin) / grid.cellSize));
+    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, grid.dims)) || !(sslpvCellCoverage[cellIndex(grid, c)] > 0.0))
+      return (float(i) - 0.5) * grid.cellSize;
+  }
+  return -1.0;
 }
 
 // Twin of singleScatteredRadiance (volume/single_scattering.cpp).
 vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
   const float cellSize = grid.cellSize;
-  vec3 extinction0, scattering0;
-  if (!reducedMediumAt(grid, p + 0.5 * cellSize * inward, extinction0, scattering0)) return vec3(0.0);
-  int group[3];
-  float reference[3];
-  const int groups = singleScatteringGroups(extinction0, group, reference);
+  const vec3 q = p + 0.5 * cellSize * inward;
+  vec3 extinction, scattering;
+  if (!reducedMediumAt(grid, q, extinction, scattering)) return vec3(0.0);
+  float clearest = 3.0e38;
+  for (int ch = 0; ch < 3; ++ch)
+    if (extinction[ch] > 0.0) clearest = min(clearest, extinction[ch]);
+  if (clearest == 3.0e38) return vec3(0.0);
+  const float exitAt = viewRayExit(grid, p, into, clearest);
   const uint views = uint(push.gridDims.w);
   vec3 sum = vec3(0.0);
-  // At least one sample spacing per grid extent, as singleScatteredRadiance.
-  const float extent = cellSize * float(max(grid.dims.x, max(grid.dims.y, grid.dims.z)));
-  for (int gi = 0; gi < groups; ++gi) {
-    const float sigma0 = max(reference[gi], 1.0 / extent);
-    vec3 opticalDepth = vec3(0.0), lastSigma = extinction0;
-    float lastS = 0.0;
-    for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
-      const float u = (float(k) + 0.5) / float(SSLPV_SINGLE_SCATTERING_SAMPLES);
-      const float s = -log(1.0 - u) / sigma0;
-      const vec3 q = p + s * into;
-      vec3 extinction, scattering;
-      if (!reducedMediumAt(grid, q, extinction, scattering)) break;
-      opticalDepth += (0.5 * extinction + 0.5 * lastSigma) * (s - lastS);  // the sum may overflow
-      lastS = s;
-      lastSigma = extinction;
-      vec3 arriving = vec3(0.0);
-      uint lastLight = 0xffffffffu;
-      for (uint v = 0u; v < views; ++v) {
-        if (shadowViews[v].texels.z == lastLight) continue;  // a cube map's other faces
-        float along;
-        const int record = texelThrough(v, q, along);
-        if (record < 0) continue;
-        lastLight = shadowViews[v].texels.z;
-        vec3 irradiance;
-        float distance, pathScale;
-        entryOf(v, record, irradiance, distance, pathScale);
-        const float below = along - distance;
-        if (irradiance == vec3(0.0) || below < -cellSize) continue;
-        const float path = max(0.0, below) * pathScale;
-        // Where the planar estimate's entry point is not on the surface the light's map
-        // sees, q gets none of this light (singleScatteredRadiance).
-        const vec3 start = q - path * shadowSamples[record].direction.xyz;
-        float startAlong;
-        const int entry = texelThrough(v, start, startAlong);
-        if (entry < 0) continue;
-        const GpuFluxSample entered = shadowSamples[entry];
-        if (entered.positionValid.w == 0.0 || entered.flux.rgb == vec3(0.0)) continue;
-        const float tolerance = max(1.5 * cellSize, 0.5 * below);
-        const float onSurface = clamp(2.0 - length(start - entered.positionValid.xyz) / tolerance, 0.0, 1.0);
-        for (int ch = 0; ch < 3; ++ch)
-          if (group[ch] == gi) arriving[ch] += onSurface * irradiance[ch] * exp(-extinction[ch] * path);
-      }
-      for (int ch = 0; ch < 3; ++ch)
-        if (group[ch] == gi) sum[ch] += scattering[ch] / sigma0 * exp(sigma0 * s - opticalDepth[ch]) * arriving[ch];
-    }
+  uint lastLight = 0xffffffffu;
+  for (uint v = 0u; v < views; ++v) {
+    if (shadowViews[v].texels.z == lastLight) continue;  // a cube map's other faces
+    float along;
+    const int record = texelThrough(v, q, along);
+    if (record < 0) continue;
+    lastLight = shadowViews[v].texels.z;
+    vec3 irradiance, gradient;
+    float distance, pathScale;
+    entryOf(v, record, irradiance, distance, pathScale, gradient);
+    const float below = along - distance;
+    if (irradiance == vec3(0.0) || below < -cellSize) continue;
+    const float path = max(0.0, below) * pathScale;
+    // Where the planar estimate's entry point is not on the surface the light's map sees,
+    // q gets none of this light (singleScatteredRadiance).
+    const vec3 start = q - path * shadowSamples[record].direction.xyz;
+    float startAlong;
+    const int entry = texelThrough(v, start, startAlong);
+    if (entry < 0) continue;
+    vec3 entryIrradiance, entryGradient;
+    float entryDistance, entryScale;
+    entryOf(v, entry, entryIrradiance, entryDistance, entryScale, entryGradient);
+    if (entryIrradiance == vec3(0.0)) continue;
+    const float tolerance = max(1.5 * cellSize, 0.5 * below);
+    const float onSurface = clamp(2.0 - length(start - shadowSamples[entry].positionValid.xyz) / tolerance, 0.0, 1.0);
+    if (!(onSurface > 0.0)) continue;
+    const float p0 = dot(p - shadowSamples[record].positionValid.xyz, gradient);
+    const float k = dot(gradient, into);
+    for (int ch = 0; ch < 3; ++ch)
+      sum[ch] += onSurface * irradiance[ch] * scattering[ch] * singleScatteringIntegral(extinction[ch], p0, k, exitAt);
   }
-  return sum / (float(SSLPV_SINGLE_SCATTERING_SAMPLES) * 4.0 * float(SSLPV_PI));
+  return sum / (4.0 * float(SSLPV_PI));
 }
 
 void main() {

@@ -41,7 +41,6 @@ CpuRenderer::~CpuRenderer() = default;
 void CpuRenderer::setCamera(const Camera& camera) {
   scene_.camera = camera;
   dirty_.cameraChanged();
-  termCache_.valid = false;
 }
 
 
@@ -83,13 +82,10 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::Resample)) {
     if (dirty_.resampleRegion()) {
-      const CellRange cells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion());
-      resampledSinceTerm_.include(cells);
-      report.resampledCells = cells.count();
+      report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion()).count();
     } else {
       resampleMaterial(object_.field(), material_);
       report.resampledCells = material_.frame.cellCount();
-      termCache_.valid = false;
     }
     factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
     report.opticalThickness = factors_.opticalThickness;
@@ -142,16 +138,10 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     report.times.markCached(Stage::Propagation);
   }
 
-  // The term reads the medium and the shadow maps' texels: a new grid, a whole new medium
-  // (above), new maps or a new camera (setCamera) leave nothing of it to reuse.
-  if (dirty_.dirty(Stage::Voxelize) || dirty_.dirty(Stage::ShadowMap)) termCache_.valid = false;
   if (dirty_.dirty(Stage::Shading)) {
     const bool calibrated = factors_.scheme == LpvScheme::Calibrated;
     image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
-                        &factors_.reducedAlbedo, calibrated ? &entries_ : nullptr,
-                        calibrated ? &termCache_ : nullptr, &resampledSinceTerm_);
-    // Seed frames leave the range growing: their shading reads no term.
-    if (calibrated) resampledSinceTerm_ = CellRange{};
+                        &factors_.reducedAlbedo, calibrated ? &entries_ : nullptr);
     report.times.shading = watch.lapMs();
   } else {
     report.times.markCached(Stage::Shading);

@@ -53,10 +53,6 @@ class CpuRenderer {
   StepFactors factors_;
   std::vector<SurfaceFluxSample> samples_;
   std::vector<EntryMap> entries_;  ///< the shadow maps' texels for the single-scattering term
-  /// The last calibrated frame's single-scattering term per pixel, and the cells
-  /// resampled since then (their medium may differ from what the cached terms read).
-  SingleScatteringCache termCache_;
-  CellRange resampledSinceTerm_;
   ShGrid injected_, accumulated_;
   RenderReport last_;
   Image image_;

@@ -69,10 +69,9 @@
 // piecewise linear in y.
 #define SSLPV_OBLIQUE_INTERVALS 4
 
-// The calibrated shading's single-scattering term (volume/single_scattering.h): samples
-// per channel along the refracted view ray, midpoints in u = 1 - exp(-sigma_t' s).
-#define SSLPV_SINGLE_SCATTERING_SAMPLES 8
-// Channels whose sigma_t' lie within this factor of their group's smallest share samples.
-#define SSLPV_SINGLE_SCATTERING_GROUP_SPREAD 1.5
+// The calibrated shading's single-scattering term (volume/single_scattering.h) looks for
+// where the view ray leaves the object this many optical depths deep (e^-6: 0.25 % of the
+// light is beyond), in steps of one cell.
+#define SSLPV_SINGLE_SCATTERING_EXIT_DEPTH 6.0
 
 #endif

@@ -16,8 +16,6 @@ namespace sslpv {
 class RayScene;
 struct Image;
 struct EntryMap;
-struct SingleScatteringCache;
-struct CellRange;
 
 /// Light that crossed the surface at one shadow-map texel.
 struct SurfaceFluxSample {
@@ -243,14 +241,11 @@ PropagationResult propagate(const MaterialGrid& material, const StepFactors& fac
 /// α', cos θo), which keeps each cell's total exitant power; null or empty: Lambertian
 /// inside the boundary.
 /// `singleScattering`: the shadow maps' entry texels; with them the calibrated
-/// single-scattering term is added. `cache`: where it is valid, pixels whose term reads
-/// no cell of `changed` (null: none changed) take the cached term instead of integrating it again (the same
-/// values: the term's inputs are the same); the frame's terms are stored in it.
+/// single-scattering term is added.
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
                  const ShGrid& accumulated, double ior,
                  const std::array<std::vector<float>, 3>* exitGain = nullptr,
                  const std::array<std::vector<float>, 3>* reducedAlbedo = nullptr,
-                 const std::vector<EntryMap>* singleScattering = nullptr,
-                 SingleScatteringCache* cache = nullptr, const CellRange* changed = nullptr);
+                 const std::vector<EntryMap>* singleScattering = nullptr);
 
 }  // namespace sslpv

@@ -19,8 +19,7 @@ namespace sslpv {
 Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
                  const ShGrid& accumulated, double ior, const std::array<std::vector<float>, 3>* exitGain,
                  const std::array<std::vector<float>, 3>* reducedAlbedo,
-                 const std::vector<EntryMap>* singleScattering, SingleScatteringCache* cache,
-                 const CellRange* changed) {
+                 const std::vector<EntryMap>* singleScattering) {
   // The calibrated exit law weights each cell by its medium's exit shape (exit_law.h).
   const bool exitLaw = reducedAlbedo != nullptr && !(*reducedAlbedo)[0].empty();
   const ExitLawTable* law = exitLaw ? &exitLawTable(ior) : nullptr;
@@ -47,13 +46,6 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
   const double radianceScale = 1.0 / (cellSize * cellSize * SSLPV_PI);
   // Radiance divided by n² is invariant across a boundary; leaving the medium it drops by 1/η².
   const double boundaryScale = 1.0 / (ior * ior);
-  const std::size_t pixels = std::size_t(camera.width) * std::size_t(camera.height);
-  const bool reuse = cache != nullptr && cache->valid && cache->term.size() == pixels;
-  if (cache != nullptr && !reuse) {
-    cache->term.assign(pixels, glm::vec3(0.0f));
-    cache->reach.assign(pixels, 0.0f);
-  }
-
   tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
     std::vector<glm::vec3> origins(camera.width), dirs(camera.width);
     std::vector<RayHit> hits(camera.width);
@@ -82,23 +74,9 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
         glm::vec3 radiance(0.0f);
         if (singleScattering != nullptr && !singleScattering->empty()) {
           const double sinT2 = (1.0 - cosOut * cosOut) / (ior * ior);
-          if (sinT2 < 1.0) {
-            const glm::dvec3 into = refractInto(glm::dvec3(dirs[x]), n, ior);
-            const std::size_t pixel = std::size_t(y) * std::size_t(camera.width) + std::size_t(x);
-            if (reuse && (changed == nullptr ||
-                          !singleScatteringReads(material.frame, p, -n, into, cache->reach[pixel], *changed))) {
-              radiance = cache->term[pixel];
-            } else {
-              double reach = 0.0;
-              radiance = singleScatteredRadiance(material, *singleScattering, p, -n, into, &reach) *
-                         float(boundaryScale * transmittance);
-              if (cache != nullptr) {
-                cache->term[pixel] = radiance;
-                // singleScatteringReads' margin covers the float rounding.
-                cache->reach[pixel] = float(reach);
-              }
-            }
-          }
+          if (sinT2 < 1.0)
+            radiance = singleScatteredRadiance(material, *singleScattering, p, -n, refractInto(glm::dvec3(dirs[x]), n, ior)) *
+                       float(boundaryScale * transmittance);
         }
         for (int ch = 0; ch < 3; ++ch) {
           sh::Coeffs c(0.0f);
@@ -116,7 +94,6 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
       }
     }
   });
-  if (cache != nullptr) cache->valid = singleScattering != nullptr && !singleScattering->empty();
   return image;
 }
 

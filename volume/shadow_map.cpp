@@ -88,7 +88,8 @@ class ShadowCaster {
             const double scale = cosT > 0.0 ? cosI / cosT : 0.0;
             entry->texels[i] = EntryTexel{hit.position, float(scale),
                                           glm::vec3(glm::dvec3(samples[i].flux) * (scale / across)), float(hit.t),
-                                          samples[i].direction};
+                                          samples[i].direction,
+                                          glm::vec3(cosT > 0.0 ? -n / cosT : glm::dvec3(0.0))};
           }
         }
       }

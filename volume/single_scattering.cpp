@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <glm/geometric.hpp>
 #include <glm/vector_relational.hpp>
 #include <utility>
@@ -57,129 +58,105 @@ const EntryTexel* texelThrough(const EntryMap& map, const glm::dvec3& q, double&
   return &map.texels[std::size_t(y) * std::size_t(view.size) + std::size_t(x)];
 }
 
+/// -expm1(-x) / x, 1 at x = 0: the mean of e^{-x u} over u in [0, 1].
+double meanDecay(double x) { return std::abs(x) < 1e-8 ? 1.0 - 0.5 * x : -std::expm1(-x) / x; }
+
 }  // namespace
 
-int singleScatteringGroups(const glm::dvec3& extinction, int group[3], double reference[3]) {
-  int order[3] = {0, 1, 2};
-  std::sort(order, order + 3, [&](int a, int b) { return extinction[a] < extinction[b]; });
-  int groups = 0;
-  double low = 0.0, high = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    const int ch = order[k];
-    const double sigma = extinction[ch];
-    if (!(sigma > 0.0)) {
-      group[ch] = -1;  // no medium: nothing scatters
-      continue;
-    }
-    if (groups == 0 || sigma > SSLPV_SINGLE_SCATTERING_GROUP_SPREAD * low) {
-      low = sigma;
-      ++groups;
-    }
-    high = sigma;
-    group[ch] = groups - 1;
-    reference[groups - 1] = std::sqrt(low) * std::sqrt(high);  // as shade.comp, whose float product overflows
+namespace {
+
+/// ∫_a^b exp(−(c + r s)) ds, evaluated from the end with the larger exponent.
+double exponentialSegment(double c, double r, double a, double b) {
+  if (!(b > a)) return 0.0;
+  const double x = r * (b - a);
+  return x >= 0.0 ? std::exp(-(c + r * a)) * (b - a) * meanDecay(x) : std::exp(-(c + r * b)) * (b - a) * meanDecay(-x);
+}
+
+}  // namespace
+
+double singleScatteringIntegral(double sigma, double p0, double k, double end) {
+  if (!(sigma > 0.0) || !(end > 0.0)) return 0.0;
+  const double infinite = std::numeric_limits<double>::infinity();
+  if (p0 < 0.0) {
+    // In front of the entry (a texel's width at most): no light leg until P reaches 0.
+    if (k <= 0.0) return end == infinite ? 1.0 / sigma : exponentialSegment(0.0, sigma, 0.0, end);
+    const double s0 = -p0 / k;
+    if (end <= s0) return exponentialSegment(0.0, sigma, 0.0, end);
+    const double rest = end == infinite ? std::exp(-sigma * s0) / (sigma * (1.0 + k))
+                                        : exponentialSegment(-sigma * k * s0, sigma * (1.0 + k), s0, end);
+    return exponentialSegment(0.0, sigma, 0.0, s0) + rest;
   }
-  return groups;
+  // Light from behind: the ray ends where P = 0, where that light entered.
+  if (k < 0.0) end = std::min(end, p0 / -k);
+  if (end == infinite) return std::exp(-sigma * p0) / (sigma * (1.0 + k));
+  return exponentialSegment(sigma * p0, sigma * (1.0 + k), 0.0, end);
+}
+
+double viewRayExit(const MaterialGrid& material, const glm::dvec3& p, const glm::dvec3& into, double extinction) {
+  const GridFrame& frame = material.frame;
+  // An optically thin object is crossed whole: its light comes from all of it.
+  const int across = std::max({frame.dims.x, frame.dims.y, frame.dims.z});
+  const int steps = int(std::min<double>(across, std::ceil(SSLPV_SINGLE_SCATTERING_EXIT_DEPTH / (extinction * frame.cellSize))));
+  for (int i = 1; i <= steps; ++i) {
+    const glm::dvec3 g = frame.toGrid(p + (i * frame.cellSize) * into);
+    const glm::ivec3 c(int(std::floor(g.x)), int(std::floor(g.y)), int(std::floor(g.z)));
+    if (!frame.contains(c.x, c.y, c.z) || !isActiveCell(material, c.x, c.y, c.z)) return (i - 0.5) * frame.cellSize;
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
-                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into,
-                                  double* reach) {
+                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into) {
   const double cellSize = material.frame.cellSize;
-  if (reach) *reach = 0.0;
-  ReducedMedium surface;
-  if (!reducedMediumAt(material, p + 0.5 * cellSize * inward, surface)) return glm::vec3(0.0f);
-  // Channels whose σt' are close share their samples (spaced for the group's reference
-  // σ): one medium and one shadow-map lookup serve them all.
-  int group[3];
-  double reference[3];
-  const int groups = singleScatteringGroups(surface.extinction, group, reference);
+  const glm::dvec3 q = p + 0.5 * cellSize * inward;
+  ReducedMedium medium;
+  if (!reducedMediumAt(material, q, medium)) return glm::vec3(0.0f);
+  // Where the view ray leaves the object, searched as deep as the most transparent
+  // channel's light can come from.
+  double clearest = std::numeric_limits<double>::infinity();
+  for (int ch = 0; ch < 3; ++ch)
+    if (medium.extinction[ch] > 0.0) clearest = std::min(clearest, medium.extinction[ch]);
+  if (clearest == std::numeric_limits<double>::infinity()) return glm::vec3(0.0f);
+  const double exit = viewRayExit(material, p, into, clearest);
   glm::dvec3 sum(0.0);
-  // The samples sit at -log(1 - u) / σ0 (any σ0 > 0 is the same integral, weighted by
-  // exp(σ0 s) / σ0); in an optically thin object spacing them by the mean free path put
-  // every one beyond the object and the term read 0. Spacing them by at most the grid's
-  // extent keeps ~60 % of them inside.
-  const GridFrame& f = material.frame;
-  const double extent = cellSize * std::max({f.dims.x, f.dims.y, f.dims.z});
-  for (int gi = 0; gi < groups; ++gi) {
-    const double sigma0 = std::max(reference[gi], 1.0 / extent);
-    glm::dvec3 opticalDepth(0.0), lastSigma = surface.extinction;
-    double lastS = 0.0;
-    for (int k = 0; k < SSLPV_SINGLE_SCATTERING_SAMPLES; ++k) {
-      const double u = (k + 0.5) / SSLPV_SINGLE_SCATTERING_SAMPLES;
-      const double s = -std::log1p(-u) / sigma0;
-      const glm::dvec3 q = p + s * into;
-      if (reach) *reach = std::max(*reach, s);
-      ReducedMedium medium;
-      if (!reducedMediumAt(material, q, medium)) break;
-      opticalDepth += 0.5 * (medium.extinction + lastSigma) * (s - lastS);
-      lastS = s;
-      lastSigma = medium.extinction;
-      glm::dvec3 arriving(0.0);
-      int lastLight = -1;
-      for (const EntryMap& map : maps) {
-        if (map.light == lastLight) continue;  // a cube map's other faces
-        double along = 0.0;
-        const EntryTexel* texel = texelThrough(map, q, along);
-        if (texel == nullptr) continue;
-        lastLight = map.light;
-        if (texel->irradiance == glm::vec3(0.0f)) continue;
-        // q can sit up to a texel in front of its entry point; light that would reach q
-        // from in front of the surface by more than a cell went round the object.
-        const double below = along - double(texel->distance);
-        if (below < -cellSize) continue;
-        const double path = std::max(0.0, below) * texel->pathScale;
-        // The planar estimate puts the entry of the beam that reaches q at q − path·d_t.
-        // Where the surface curves away from the entry's tangent plane (past the light's
-        // terminator, behind a grazing entry) that point is not where light enters: the
-        // light's own map sees its surface elsewhere, and q gets none of this light. The
-        // cut is a ramp (full up to the tolerance, none beyond twice it), so that a texel
-        // boundary or a rounding cannot switch a sample's light on or off.
-        double entryAlong = 0.0;
-        const glm::dvec3 start = q - path * glm::dvec3(texel->direction);
-        const EntryTexel* entry = texelThrough(map, start, entryAlong);
-        if (entry == nullptr || entry->irradiance == glm::vec3(0.0f)) continue;
-        const double tolerance = std::max(1.5 * cellSize, 0.5 * below);
-        const double onSurface =
-            std::clamp(2.0 - glm::length(start - glm::dvec3(entry->position)) / tolerance, 0.0, 1.0);
-        for (int ch = 0; ch < 3; ++ch)
-          if (group[ch] == gi)
-            arriving[ch] += onSurface * texel->irradiance[ch] * std::exp(-medium.extinction[ch] * path);
-      }
-      // ∫ σs' e^{-τ} f ds in the variable u: ds = du / (σ0 (1 − u)), and 1 − u = e^{-σ0 s}.
-      for (int ch = 0; ch < 3; ++ch)
-        if (group[ch] == gi)
-          sum[ch] += medium.scattering[ch] / sigma0 * std::exp(sigma0 * s - opticalDepth[ch]) * arriving[ch];
-    }
+  int lastLight = -1;
+  for (const EntryMap& map : maps) {
+    if (map.light == lastLight) continue;  // a cube map's other faces
+    double along = 0.0;
+    const EntryTexel* texel = texelThrough(map, q, along);
+    if (texel == nullptr) continue;
+    lastLight = map.light;
+    if (texel->irradiance == glm::vec3(0.0f)) continue;
+    // q can sit up to a texel in front of its entry point; light that would reach q from
+    // in front of the surface by more than a cell went round the object.
+    const double below = along - double(texel->distance);
+    if (below < -cellSize) continue;
+    const double path = std::max(0.0, below) * texel->pathScale;
+    // The planar estimate puts the entry of the beam that reaches q at q − path·d_t. Where
+    // the surface curves away from the entry's tangent plane (past the light's terminator,
+    // behind a grazing entry) that point is not where light enters: the light's own map
+    // sees its surface elsewhere, and q gets none of this light. The cut is a ramp (full up
+    // to the tolerance, none beyond twice it), so that a texel boundary or a rounding
+    // cannot switch a pixel's light on or off.
+    double entryAlong = 0.0;
+    const glm::dvec3 start = q - path * glm::dvec3(texel->direction);
+    const EntryTexel* entry = texelThrough(map, start, entryAlong);
+    if (entry == nullptr || entry->irradiance == glm::vec3(0.0f)) continue;
+    const double tolerance = std::max(1.5 * cellSize, 0.5 * below);
+    const double onSurface = std::clamp(2.0 - glm::length(start - glm::dvec3(entry->position)) / tolerance, 0.0, 1.0);
+    if (onSurface <= 0.0) continue;
+    // P is linear below a planar entry face: at the surface point p it is p's depth below
+    // the texel's tangent plane over cos θt (exact wherever p lies in the texel's
+    // footprint, which a grazing light stretches over cells), and it changes along the
+    // view ray by its gradient.
+    const glm::dvec3 gradient(texel->pathGradient);
+    const double p0 = glm::dot(p - glm::dvec3(texel->position), gradient);
+    const double k = glm::dot(gradient, into);
+    for (int ch = 0; ch < 3; ++ch)
+      sum[ch] += onSurface * texel->irradiance[ch] * medium.scattering[ch] *
+                 singleScatteringIntegral(medium.extinction[ch], p0, k, exit);
   }
-  return glm::vec3(sum / (SSLPV_SINGLE_SCATTERING_SAMPLES * 4.0 * SSLPV_PI));
-}
-
-bool singleScatteringReads(const GridFrame& frame, const glm::dvec3& p, const glm::dvec3& inward,
-                           const glm::dvec3& into, double reach, const CellRange& cells) {
-  if (cells.empty()) return false;
-  // activeTrilinearWeights reads cells floor(g) and floor(g) + 1, g = toGrid(q) − 0.5, so
-  // cell c is read from g in [c − 1, c + 1); a margin keeps rounding on the safe side.
-  constexpr double kMargin = 1e-3;
-  const glm::dvec3 lo = glm::dvec3(cells.lo) - 1.0 - kMargin, hi = glm::dvec3(cells.hi) + 1.0 + kMargin;
-  const auto grid = [&](const glm::dvec3& q) { return frame.toGrid(q) - 0.5; };
-  const glm::dvec3 surface = grid(p + 0.5 * frame.cellSize * inward);
-  if (glm::all(glm::greaterThanEqual(surface, lo)) && glm::all(glm::lessThanEqual(surface, hi))) return true;
-  // The segment against the box, slab by slab.
-  const glm::dvec3 a = grid(p), d = grid(p + reach * into) - a;
-  double t0 = 0.0, t1 = 1.0;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (std::abs(d[axis]) < 1e-12) {
-      if (a[axis] < lo[axis] || a[axis] > hi[axis]) return false;
-      continue;
-    }
-    double enter = (lo[axis] - a[axis]) / d[axis], leave = (hi[axis] - a[axis]) / d[axis];
-    if (enter > leave) std::swap(enter, leave);
-    t0 = std::max(t0, enter);
-    t1 = std::min(t1, leave);
-    if (t0 > t1) return false;
-  }
-  return true;
+  return glm::vec3(sum / (4.0 * SSLPV_PI));
 }
 
 }  // namespace sslpv
