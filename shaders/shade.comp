@@ -140,18 +140,26 @@ float exponentialSegment(float c, float r, float a, float b) {
 // Twin of singleScatteringIntegral (volume/single_scattering.cpp); `end` < 0 stands for ∞.
 float singleScatteringIntegral(float sigma, float p0, float k, float end) {
   if (!(sigma > 0.0) || end == 0.0) return 0.0;
-  const bool infinite = end < 0.0;
-  if (p0 < 0.0) {
-    if (k <= 0.0) return infinite ? 1.0 / sigma : exponentialSegment(0.0, sigma, 0.0, end);
-    const float s0 = -p0 / k;
-    if (!infinite && end <= s0) return exponentialSegment(0.0, sigma, 0.0, end);
-    const float rest = infinite ? exp(-sigma * s0) / (sigma * (1.0 + k))
-                                : exponentialSegment(-sigma * k * s0, sigma * (1.0 + k), s0, end);
-    return exponentialSegment(0.0, sigma, 0.0, s0) + rest;
+  bool infinite = end < 0.0;
+  if (infinite && k < 0.0 && p0 >= 0.0) {
+    end = p0 / -k;
+    infinite = false;
   }
-  if (k < 0.0) end = infinite ? p0 / -k : min(end, p0 / -k);
-  else if (infinite) return exp(-sigma * p0) / (sigma * (1.0 + k));
-  return exponentialSegment(sigma * p0, sigma * (1.0 + k), 0.0, end);
+  const float kink = k != 0.0 ? -p0 / k : -1.0;
+  float total = 0.0, from = 0.0;
+  for (int piece = 0; piece < 2; ++piece) {
+    const bool last = piece == 1 || !(kink > 0.0 && (infinite || kink < end));
+    const bool toInfinity = last && infinite;
+    const float to = last ? end : kink;
+    if (!toInfinity && !(to > from)) continue;
+    const float inside = toInfinity ? from + 1.0 : 0.5 * (from + to);
+    const bool lit = p0 + k * inside > 0.0;
+    const float c = lit ? sigma * p0 : 0.0, r = lit ? sigma * (1.0 + k) : sigma;
+    total += toInfinity ? exp(-(c + r * from)) / r : exponentialSegment(c, r, from, to);
+    from = to;
+    if (last) break;
+  }
+  return total;
 }
 
 // Twin of viewRayExit (volume/single_scattering.cpp); -1 for ∞.
@@ -169,14 +177,19 @@ float viewRayExit(CellGrid grid, vec3 p, vec3 into, float extinction) {
 // Twin of singleScatteredRadiance (volume/single_scattering.cpp).
 vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
   const float cellSize = grid.cellSize;
-  const vec3 q = p + 0.5 * cellSize * inward;
+  vec3 q = p + 0.5 * cellSize * inward;
   vec3 extinction, scattering;
   if (!reducedMediumAt(grid, q, extinction, scattering)) return vec3(0.0);
-  float clearest = 3.0e38;
+  float clearest = 3.0e38, densest = 0.0;
   for (int ch = 0; ch < 3; ++ch)
-    if (extinction[ch] > 0.0) clearest = min(clearest, extinction[ch]);
+    if (extinction[ch] > 0.0) {
+      clearest = min(clearest, extinction[ch]);
+      densest = max(densest, extinction[ch]);
+    }
   if (clearest == 3.0e38) return vec3(0.0);
   const float exitAt = viewRayExit(grid, p, into, clearest);
+  // An optically thin chord: its light is read at its middle (singleScatteredRadiance).
+  if (exitAt >= 0.0 && densest * exitAt < 1.0) q = p + 0.5 * exitAt * into;
   const uint views = uint(push.gridDims.w);
   vec3 sum = vec3(0.0);
   uint lastLight = 0xffffffffu;

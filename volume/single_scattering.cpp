@@ -77,19 +77,20 @@ double exponentialSegment(double c, double r, double a, double b) {
 double singleScatteringIntegral(double sigma, double p0, double k, double end) {
   if (!(sigma > 0.0) || !(end > 0.0)) return 0.0;
   const double infinite = std::numeric_limits<double>::infinity();
-  if (p0 < 0.0) {
-    // In front of the entry (a texel's width at most): no light leg until P reaches 0.
-    if (k <= 0.0) return end == infinite ? 1.0 / sigma : exponentialSegment(0.0, sigma, 0.0, end);
-    const double s0 = -p0 / k;
-    if (end <= s0) return exponentialSegment(0.0, sigma, 0.0, end);
-    const double rest = end == infinite ? std::exp(-sigma * s0) / (sigma * (1.0 + k))
-                                        : exponentialSegment(-sigma * k * s0, sigma * (1.0 + k), s0, end);
-    return exponentialSegment(0.0, sigma, 0.0, s0) + rest;
+  // Where no exit was found, light from behind ends the ray at its own entry (P = 0).
+  if (end == infinite && k < 0.0 && p0 >= 0.0) end = p0 / -k;
+  // P(s) = p0 + k s changes sign at most once; on each side the integrand is one exponential.
+  const double kink = k != 0.0 ? -p0 / k : -1.0;
+  double total = 0.0, from = 0.0;
+  for (const double to : {kink > 0.0 && kink < end ? kink : end, end}) {
+    if (!(to > from)) continue;
+    const double inside = to == infinite ? from + 1.0 : 0.5 * (from + to);
+    const bool lit = p0 + k * inside > 0.0;
+    const double c = lit ? sigma * p0 : 0.0, r = lit ? sigma * (1.0 + k) : sigma;
+    total += to == infinite ? std::exp(-(c + r * from)) / r : exponentialSegment(c, r, from, to);
+    from = to;
   }
-  // Light from behind: the ray ends where P = 0, where that light entered.
-  if (k < 0.0) end = std::min(end, p0 / -k);
-  if (end == infinite) return std::exp(-sigma * p0) / (sigma * (1.0 + k));
-  return exponentialSegment(sigma * p0, sigma * (1.0 + k), 0.0, end);
+  return total;
 }
 
 double viewRayExit(const MaterialGrid& material, const glm::dvec3& p, const glm::dvec3& into, double extinction) {
@@ -108,16 +109,23 @@ double viewRayExit(const MaterialGrid& material, const glm::dvec3& p, const glm:
 glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
                                   const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into) {
   const double cellSize = material.frame.cellSize;
-  const glm::dvec3 q = p + 0.5 * cellSize * inward;
+  glm::dvec3 q = p + 0.5 * cellSize * inward;
   ReducedMedium medium;
   if (!reducedMediumAt(material, q, medium)) return glm::vec3(0.0f);
   // Where the view ray leaves the object, searched as deep as the most transparent
   // channel's light can come from.
-  double clearest = std::numeric_limits<double>::infinity();
+  double clearest = std::numeric_limits<double>::infinity(), densest = 0.0;
   for (int ch = 0; ch < 3; ++ch)
-    if (medium.extinction[ch] > 0.0) clearest = std::min(clearest, medium.extinction[ch]);
+    if (medium.extinction[ch] > 0.0) {
+      clearest = std::min(clearest, medium.extinction[ch]);
+      densest = std::max(densest, medium.extinction[ch]);
+    }
   if (clearest == std::numeric_limits<double>::infinity()) return glm::vec3(0.0f);
   const double exit = viewRayExit(material, p, into, clearest);
+  // Where the whole chord is under a mean free path, its light comes from all along it,
+  // not from below the surface: the entry is read at the chord's middle (a point just
+  // under the surface may lie past the terminator of a light that lights the inside).
+  if (densest * exit < 1.0) q = p + 0.5 * exit * into;
   glm::dvec3 sum(0.0);
   int lastLight = -1;
   for (const EntryMap& map : maps) {

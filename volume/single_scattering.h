@@ -39,9 +39,9 @@ struct EntryMap {
 
 /// ∫_0^S exp(−σ s − σ max(0, p0 + k s)) ds: the once-scattered light along a refracted view
 /// ray in a medium of reduced extinction σ, where the light's refracted path from its entry
-/// is p0 + k s at distance s along the ray (k = ∇P · t). The ray leaves the object at
-/// `end` (∞: not within reach); where P falls (k < 0, light from behind) it ends where
-/// P = 0, where that light entered, S = min(end, p0 / (−k)).
+/// is p0 + k s at distance s along the ray (k = ∇P · t; past P = 0 the light leg is
+/// empty). The ray leaves the object at `end`; where that is ∞ (not within reach) and P
+/// falls (k < 0, light from behind), it ends where P = 0, where that light entered.
 double singleScatteringIntegral(double sigma, double p0, double k,
                                 double end = std::numeric_limits<double>::infinity());
 
