@@ -114,15 +114,21 @@ struct LitSlab {
   std::vector<EntryMap> maps;
 };
 
-LitSlab litSlab(float irradiance, bool fromBelow = false) {
-  LitSlab slab;
-  const TriangleMesh mesh = makeBoxMesh(glm::vec3(-10.0f, -10.0f, -10.0f), glm::vec3(10.0f, 0.0f, 10.0f));
-  MaterialGrid& m = slab.material;
-  m.frame = makeGridFrame(mesh.bounds(), 32);
+/// The medium of a slab 20 wide from y = `bottom` to its top face y = 0, σt = 1, σs = 0.5.
+MaterialGrid slabMedium(float bottom, int resolution) {
+  const TriangleMesh mesh = makeBoxMesh(glm::vec3(-10.0f, bottom, -10.0f), glm::vec3(10.0f, 0.0f, 10.0f));
+  MaterialGrid m;
+  m.frame = makeGridFrame(mesh.bounds(), resolution);
   m.coverage = voxelizeCoverage(mesh, m.frame);
   m.sigmaT.assign(m.frame.cellCount(), glm::vec3(1.0f));
   m.sigmaS.assign(m.frame.cellCount(), glm::vec3(0.5f));
   m.g.assign(m.frame.cellCount(), 0.0f);
+  return m;
+}
+
+LitSlab litSlab(float irradiance, bool fromBelow = false) {
+  LitSlab slab;
+  slab.material = slabMedium(-10.0f, 32);
   EntryMap map;
   ShadowView& view = map.view;
   const double down = fromBelow ? -1.0 : 1.0;
@@ -235,13 +241,8 @@ TEST(SingleScatteredRadiance, ThinSlabEndsWhereTheViewRayLeaves) {
   // the view ray leaves at the bottom face, L = σs E (1 − e^{-2}) / (4π σt · 2). The exit is
   // found to within half a cell (64³ here: 1/3 unit).
   LitSlab slab = litSlab(1.0f);
-  const TriangleMesh thin = makeBoxMesh(glm::vec3(-10.0f, -1.0f, -10.0f), glm::vec3(10.0f, 0.0f, 10.0f));
-  MaterialGrid& m = slab.material;
-  m.frame = makeGridFrame(thin.bounds(), 64);
-  m.coverage = voxelizeCoverage(thin, m.frame);
-  m.sigmaT.assign(m.frame.cellCount(), glm::vec3(1.0f));
-  m.sigmaS.assign(m.frame.cellCount(), glm::vec3(0.5f));
-  m.g.assign(m.frame.cellCount(), 0.0f);
+  slab.material = slabMedium(-1.0f, 64);
+  const MaterialGrid& m = slab.material;
   const glm::dvec3 down(0.0, -1.0, 0.0);
   const glm::vec3 radiance = singleScatteredRadiance(m, slab.maps, glm::dvec3(0.3, 0.0, -0.2), down, down);
   const double thick = 0.5 / (4.0 * SSLPV_PI * 2.0);
