@@ -202,10 +202,10 @@ TEST(Scene, UnitsAcceptEveryListedUnit) {
 
 TEST(Scene, PathsResolveAgainstSceneFolderNotWorkingDirectory) {
   json j = minimalScene();
-  j["mesh"] = {{"path", "../shared/mesh.obj"}};
+  j["mesh"] = {{"path", "../meshes/mesh.obj"}};
   j["material"]["vdb"] = "sets/a.vdb";
   Scene s = parseScene(j.dump(), fs::path("/data/scenes/s.json"));
-  EXPECT_EQ(s.mesh.path, fs::path("/data/shared/mesh.obj"));
+  EXPECT_EQ(s.mesh.path, fs::path("/data/meshes/mesh.obj"));
   EXPECT_EQ(*s.material.vdb, fs::path("/data/scenes/sets/a.vdb"));
 
   j["mesh"]["path"] = "/abs/m.ply";
