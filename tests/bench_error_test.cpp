@@ -16,6 +16,7 @@
 #include "test_support.h"
 #include "volume/bench_table.h"
 #include "volume/error.h"
+#include "volume/material_set.h"
 #include "volume/scene.h"
 
 namespace sslpv::test {
@@ -300,6 +301,32 @@ TEST(BenchErrorCache, KeyFollowsTheContentOfTheSceneAndTheFilesItNames) {
   EXPECT_NE(afterMeshEdit, afterSceneEdit);
   // The tracer's light-connection mode is part of the key when it is given.
   EXPECT_NE(sceneContentHash(loadScene(dir / "scene.json"), "exact flat-face light connections"), afterMeshEdit);
+}
+
+TEST(BenchErrorCache, ASavedAgainMaterialSetKeepsItsKeyAndAChangedVoxelDoesNot) {
+  // OpenVDB writes a new random UUID into every file; only the grids may count.
+  TempDir dir;
+  MaterialSet set;
+  set.sigmaT = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  set.sigmaS = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  set.sigmaT->tree().setValue(openvdb::Coord(0, 0, 0), openvdb::Vec3s(2.0f));
+  set.sigmaS->tree().setValue(openvdb::Coord(0, 0, 0), openvdb::Vec3s(1.0f));
+  saveMaterialSet(set, dir / "set.vdb");
+  writeText(dir / "tetra.obj", kTetra);
+  std::string text = kSceneText;
+  const std::string base = R"({"preset": "marble"})";
+  text.replace(text.find(base), base.size(), base + R"(, "vdb": "set.vdb")");
+  writeText(dir / "scene.json", text);
+  const std::string first = sceneContentHash(loadScene(dir / "scene.json"));
+  const std::string firstBytes = readText(dir / "set.vdb");
+
+  saveMaterialSet(set, dir / "set.vdb");
+  ASSERT_NE(readText(dir / "set.vdb"), firstBytes) << "OpenVDB no longer writes a random UUID; this test is moot";
+  EXPECT_EQ(sceneContentHash(loadScene(dir / "scene.json")), first);
+
+  set.sigmaS->tree().setValue(openvdb::Coord(0, 0, 0), openvdb::Vec3s(1.5f));
+  saveMaterialSet(set, dir / "set.vdb");
+  EXPECT_NE(sceneContentHash(loadScene(dir / "scene.json")), first);
 }
 
 TEST(BenchErrorCache, FileHashSeesEveryByte) {
