@@ -263,6 +263,11 @@ bool BrushControls::pickSwatch(std::size_t i) {
   return true;
 }
 
+void BrushControls::selectColourChannel() {
+  channel_ = BrushChannel::Colour;
+  mode_ = BrushMode::Set;
+}
+
 void BrushControls::cycleSwatch(int direction) {
   const std::size_t n = swatches_.size();
   if (n == 0) return;
@@ -348,12 +353,9 @@ std::string BrushControls::describe() const {
       text += " " + b.preset;
       break;
     case BrushChannel::Colour: {
-      // Both views: what the artist picked and what the grids will store.
-      const MaterialSample m = artistToPhysical(b.artist, ior_);
       char g[64];
       std::snprintf(g, sizeof g, " g %.3g", b.artist.g);
-      text += " " + formatRgb(b.artist.colour) + " dist " + formatRgb(b.artist.scatterDistance) + " " + units_ + g +
-              " = sigma_t " + formatRgb(glm::dvec3(m.sigmaT)) + " sigma_s " + formatRgb(glm::dvec3(m.sigmaS)) + per;
+      text += " " + formatRgb(b.artist.colour) + " dist " + formatRgb(b.artist.scatterDistance) + " " + units_ + g;
       break;
     }
     case BrushChannel::All:
@@ -371,6 +373,15 @@ std::string BrushControls::describe() const {
     text += d;
   }
   return text;
+}
+
+std::string BrushControls::describeStored() const {
+  if (channel_ != BrushChannel::Colour) return {};
+  const MaterialSample m = artistToPhysical(artist_, ior_);
+  char g[48];
+  std::snprintf(g, sizeof g, ", g %.3g", double(m.g));
+  return "stores sigma_t " + formatRgb(glm::dvec3(m.sigmaT)) + " sigma_s " + formatRgb(glm::dvec3(m.sigmaS)) + " /" +
+         units_ + g;
 }
 
 std::string BrushControls::displayChannel() const {

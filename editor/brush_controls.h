@@ -58,6 +58,7 @@ class BrushControls {
   std::string artistFieldText(int field) const;
   static const char* artistFieldName(int field);  ///< "colour", "scatter distance", "g"
   const ArtistParams& artist() const { return artist_; }
+  void selectColourChannel();  ///< the colour channel, mode set, values unchanged
   double ior() const { return ior_; }
   /// Which RGB component adjustValue/adjustAlbedo change: all, then r, g, b.
   void cycleComponent();
@@ -70,6 +71,9 @@ class BrushControls {
 
   /// One status line: "sigma_t set [1.2 1.5 2] /mm | radius 1.5 mm | smooth | ...".
   std::string describe() const;
+  /// The colour brush's other view, what the grids will hold: "stores sigma_t [..] sigma_s
+  /// [..] /mm, g 0.3" ("" for the other channels, whose values are σ already).
+  std::string describeStored() const;
   /// What the slice views show for this brush: "sigma_t", "sigma_s", "g" or "albedo"
   /// (colour: "albedo", σs/σt, the closest of the four to what it sets).
   std::string displayChannel() const;

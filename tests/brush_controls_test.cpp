@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "editor/brush_controls.h"
@@ -199,7 +200,14 @@ TEST(BrushControls, SwatchesAreTheJensenMaterialsAndTypedEntryIsChecked) {
   EXPECT_EQ(b.artist.g, 0.25);
   EXPECT_EQ(controls.artistFieldText(0), "0.8, 0.4, 0.1");
   const std::string text = controls.describe();
-  EXPECT_NE(text.find("colour set [0.8 0.4 0.1] dist 2 mm g 0.25 = sigma_t ["), std::string::npos) << text;
+  EXPECT_NE(text.find("colour set [0.8 0.4 0.1] dist 2 mm g 0.25"), std::string::npos) << text;
+  const MaterialSample stored = artistToPhysical(b.artist, ior);
+  char expected[160];
+  std::snprintf(expected, sizeof expected, "stores sigma_t [%.3g %.3g %.3g] sigma_s [%.3g %.3g %.3g] /mm, g 0.25",
+                stored.sigmaT.x, stored.sigmaT.y, stored.sigmaT.z, stored.sigmaS.x, stored.sigmaS.y, stored.sigmaS.z);
+  EXPECT_EQ(controls.describeStored(), expected);
+  controls.cycleChannel(+1);
+  EXPECT_EQ(controls.describeStored(), "") << "sigma_t's value is already what is stored";
 
   EXPECT_NE(controls.enterArtistField(0, "0.5, 0.99, 0.5").find("colour[1]: must be in [0, 0.98"), std::string::npos);
   EXPECT_EQ(controls.enterArtistField(0, "0.5, 0.5"), "colour: expected one number or three, got \"0.5, 0.5\"");
