@@ -1,8 +1,12 @@
 #include "apps/cmd_paint.h"
 
 #include <cctype>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <optional>
+#include <vector>
 
 #include "editor/brush_engine.h"
 #include "editor/stroke_io.h"
@@ -10,6 +14,7 @@
 #include "volume/error.h"
 #include "volume/material_set.h"
 #include "volume/scene.h"
+#include "volume/strict_json.h"
 
 namespace sslpv {
 
@@ -18,8 +23,63 @@ CLI::App* addPaintCommand(CLI::App& app, PaintArgs& args) {
   cmd->add_option("scene", args.scene, "Scene JSON file")->required();
   cmd->add_option("--strokes", args.strokes, "Stroke JSON file (format: README, editor/stroke_io.h)")->required();
   cmd->add_option("-o,--output", args.output, "Output material set (.vdb)")->required();
+  cmd->add_option("--colour,--color", args.colour,
+                  "Surface colour (linear diffuse reflectance, R,G,B or one number) of strokes that name no material");
+  cmd->add_option("--scatter-distance", args.scatterDistance,
+                  "Scatter distance 1/sigma_t' (scene units, R,G,B or one number) for --colour");
+  cmd->add_option("--g", args.g, "Phase asymmetry g in [-0.99, 0.99] for --colour (default 0)");
   return cmd;
 }
+
+namespace {
+
+/// "x" or "r,g,b": finite numbers, the whole text consumed. Throws InputError naming the flag.
+glm::dvec3 parseFlagRgb(const std::string& text, const std::string& flag) {
+  std::vector<double> values;
+  std::size_t at = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', at);
+    const std::string item = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v) ||
+        item.find_first_of(" \t") != std::string::npos)
+      throw InputError(flag + ": expected one number or R,G,B, got \"" + printable(text) + "\"");
+    values.push_back(v);
+    if (comma == std::string::npos) break;
+    at = comma + 1;
+  }
+  if (values.size() == 1) return glm::dvec3(values[0]);
+  if (values.size() != 3)
+    throw InputError(flag + ": expected one number or R,G,B, got " + std::to_string(values.size()) + " numbers");
+  return {values[0], values[1], values[2]};
+}
+
+/// The flags' material, checked against the scene's ior; nullopt when no flag was given.
+std::optional<ArtistParams> flagMaterial(const PaintArgs& args, double ior) {
+  if (args.colour.empty() && args.scatterDistance.empty() && args.g.empty()) return std::nullopt;
+  if (args.colour.empty())
+    throw InputError(std::string(args.scatterDistance.empty() ? "--g" : "--scatter-distance") +
+                     ": needs --colour (the material of strokes that name none)");
+  if (args.scatterDistance.empty()) throw InputError("--colour: needs --scatter-distance");
+  ArtistParams p;
+  p.colour = parseFlagRgb(args.colour, "--colour");
+  p.scatterDistance = parseFlagRgb(args.scatterDistance, "--scatter-distance");
+  if (!args.g.empty()) {
+    const glm::dvec3 g = parseFlagRgb(args.g, "--g");
+    if (!(g.x == g.y && g.y == g.z)) throw InputError("--g: expected one number, got \"" + printable(args.g) + "\"");
+    p.g = g.x;
+  }
+  // The mapping names its keys as the stroke file spells them; the flags' spelling here.
+  std::string problem = artistParamsProblem(p, ior);
+  if (!problem.empty()) {
+    if (problem.rfind("scatter_distance", 0) == 0) problem.replace(0, 16, "scatter-distance");
+    throw InputError("--" + problem);
+  }
+  return p;
+}
+
+}  // namespace
 
 int runPaint(const PaintArgs& args) {
   std::string ext = std::filesystem::path(args.output).extension().string();
@@ -29,7 +89,8 @@ int runPaint(const PaintArgs& args) {
 
   const Scene scene = loadScene(args.scene);
   // Parsed before the mesh and grids load, so a typo in the strokes fails fast.
-  const std::vector<Stroke> strokes = loadStrokes(args.strokes);
+  const std::optional<ArtistParams> bare = flagMaterial(args, scene.material.ior);
+  const std::vector<Stroke> strokes = loadStrokes(args.strokes, bare ? &*bare : nullptr);
   // The target's own refusals name a role ("material set: ...", "box: ..."), not the
   // scene they come from.
   auto engineFor = [&] {

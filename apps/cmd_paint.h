@@ -1,7 +1,10 @@
 #pragma once
-// `sslpv paint SCENE.json --strokes STROKES.json -o OUT.vdb`: applies a stroke file (format
-// in editor/stroke_io.h) to the scene's material set (or to empty grids when the scene has
-// none) with the brush engine the editor uses, and writes the painted set atomically.
+// `sslpv paint SCENE.json --strokes STROKES.json -o OUT.vdb [--colour C --scatter-distance D
+// [--g G]]`: applies a stroke file (format in editor/stroke_io.h) to the scene's material
+// set (or to empty grids when the scene has none) with the brush engine the editor uses,
+// and writes the painted set atomically. The flags give the material, as surface colour
+// and scatter distance (volume/artist_params.h), of strokes that name none, so one file of
+// paths can be painted in any colour.
 #include <CLI/CLI.hpp>
 #include <string>
 
@@ -11,6 +14,9 @@ struct PaintArgs {
   std::string scene;    ///< scene JSON
   std::string strokes;  ///< stroke JSON
   std::string output;   ///< .vdb material set
+  /// The colour form for strokes that name no material (editor/stroke_io.h): "R,G,B" or
+  /// one number each; empty when not given. g is optional, the other two go together.
+  std::string colour, scatterDistance, g;
 };
 
 CLI::App* addPaintCommand(CLI::App& app, PaintArgs& args);

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <glm/common.hpp>
 #include <vector>
 
 #include "volume/material.h"
+#include "volume/material_set.h"
 
 namespace sslpv {
 namespace {
@@ -13,6 +16,9 @@ namespace {
 constexpr double kValueStep = 1.25;
 constexpr double kGStep = 0.05;
 constexpr double kAlbedoStep = 0.02;
+// Scatter distances beyond this are an empty medium for any object; keeps repeated x1.25
+// steps finite.
+constexpr double kMaxScatterDistance = 1e30;
 
 bool valuedMode(BrushMode mode) {
   return mode == BrushMode::Set || mode == BrushMode::Add || mode == BrushMode::Multiply;
@@ -21,6 +27,7 @@ bool valuedMode(BrushMode mode) {
 // The modes each channel accepts, in cycling order (brushProblem's rules).
 std::vector<BrushMode> modesOf(BrushChannel channel) {
   switch (channel) {
+    case BrushChannel::Colour:
     case BrushChannel::AlbedoMfp:
     case BrushChannel::Preset:
       return {BrushMode::Set};
@@ -33,6 +40,7 @@ std::vector<BrushMode> modesOf(BrushChannel channel) {
 
 const char* channelName(BrushChannel c) {
   switch (c) {
+    case BrushChannel::Colour: return "colour";
     case BrushChannel::SigmaT: return "sigma_t";
     case BrushChannel::SigmaS: return "sigma_s";
     case BrushChannel::G: return "g";
@@ -73,10 +81,38 @@ std::string formatRgb(const glm::dvec3& v) {
   return text;
 }
 
+/// Numbers separated by commas and/or spaces, all of the text used; empty on any junk.
+std::vector<double> parseNumbers(const std::string& text) {
+  std::vector<double> values;
+  const char* p = text.c_str();
+  while (true) {
+    while (*p == ' ' || *p == ',') ++p;
+    if (!*p) break;
+    char* end = nullptr;
+    const double v = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v) || (*end && *end != ' ' && *end != ',')) return {};
+    values.push_back(v);
+    p = end;
+  }
+  return values;
+}
+
 }  // namespace
 
-BrushControls::BrushControls(const MaterialSample& base, double objectWorldExtent, std::string sceneUnits)
-    : units_(std::move(sceneUnits)) {
+BrushControls::BrushControls(const MaterialSample& base, double objectWorldExtent, std::string sceneUnits,
+                             double ior)
+    : ior_(ior > 0.0 && std::isfinite(ior) ? ior : 1.0), units_(std::move(sceneUnits)) {
+  // The base as the artist sees it, darkened so a first stroke shows; an empty channel
+  // (infinite distance) starts at a unit distance.
+  artist_ = physicalToArtist(base, ior_);
+  artist_.colour *= 0.5;
+  for (int c = 0; c < 3; ++c)
+    if (!(artist_.scatterDistance[c] >= kMinScatterDistance && artist_.scatterDistance[c] <= kMaxScatterDistance))
+      artist_.scatterDistance[c] = 1.0;
+  artist_.g = std::clamp(artist_.g, -kArtistMaxG, kArtistMaxG);
+  const double unit = unitInMm(units_).value_or(1.0);
+  for (const MeasuredMaterial& m : measuredMaterials())
+    swatches_.push_back(physicalToArtist(*presetMaterial(m.name, 0.0f, unit), ior_));
   const glm::dvec3 sigmaT(base.sigmaT), sigmaS(base.sigmaS);
   // Where the base is empty (σt = 0) a unit density is a sensible first stroke.
   const glm::dvec3 denser = glm::max(2.0 * sigmaT, glm::dvec3(1e-3));
@@ -109,6 +145,7 @@ Brush BrushControls::brush() const {
   b.albedo = albedo_;
   b.meanFreePath = meanFreePath_;
   b.preset = std::string(measuredMaterials()[preset_].name);
+  b.artist = artist_;
   b.radius = radius_;
   b.falloff = falloff_;
   b.strength = strength_;
@@ -118,9 +155,10 @@ Brush BrushControls::brush() const {
 }
 
 void BrushControls::cycleChannel(int direction) {
-  constexpr BrushChannel order[] = {BrushChannel::SigmaT, BrushChannel::SigmaS, BrushChannel::G,
-                                    BrushChannel::AlbedoMfp, BrushChannel::Preset, BrushChannel::All};
-  constexpr int n = 6;
+  constexpr BrushChannel order[] = {BrushChannel::Colour,    BrushChannel::SigmaT, BrushChannel::SigmaS,
+                                    BrushChannel::G,         BrushChannel::AlbedoMfp, BrushChannel::Preset,
+                                    BrushChannel::All};
+  constexpr int n = 7;
   int i = int(std::find(order, order + n, channel_) - order);
   i = ((i + (direction >= 0 ? 1 : -1)) % n + n) % n;
   channel_ = order[i];
@@ -176,6 +214,11 @@ void BrushControls::adjustValue(int direction) {
     case BrushChannel::AlbedoMfp:
       scale(meanFreePath_);
       break;
+    case BrushChannel::Colour:
+      scale(artist_.scatterDistance);
+      artist_.scatterDistance =
+          glm::clamp(artist_.scatterDistance, glm::dvec3(kMinScatterDistance), glm::dvec3(kMaxScatterDistance));
+      break;
     case BrushChannel::Preset: {
       const std::size_t n = measuredMaterials().size();
       preset_ = (preset_ + (direction >= 0 ? 1 : n - 1)) % n;
@@ -187,10 +230,87 @@ void BrushControls::adjustValue(int direction) {
 }
 
 void BrushControls::adjustAlbedo(int direction) {
+  if (channel_ == BrushChannel::Colour) {
+    const double top = maxSurfaceColour(ior_);
+    for (int c = 0; c < 3; ++c)
+      if (component_ < 0 || component_ == c)
+        artist_.colour[c] = std::clamp(
+            std::round((artist_.colour[c] + (direction >= 0 ? kAlbedoStep : -kAlbedoStep)) * 1000.0) / 1000.0, 0.0, top);
+    return;
+  }
   for (int c = 0; c < 3; ++c)
     if (component_ < 0 || component_ == c)
       albedo_[c] = std::clamp(std::round((albedo_[c] + (direction >= 0 ? kAlbedoStep : -kAlbedoStep)) * 1000.0) / 1000.0,
                               0.0, 1.0);
+}
+
+void BrushControls::adjustArtistG(int direction) {
+  if (channel_ != BrushChannel::Colour) return;
+  artist_.g = std::clamp(std::round((artist_.g + (direction >= 0 ? kGStep : -kGStep)) * 1000.0) / 1000.0, -kArtistMaxG,
+                         kArtistMaxG);
+}
+
+std::string BrushControls::swatchName(std::size_t i) const {
+  return i < swatches_.size() ? std::string(measuredMaterials()[i].name) : std::string();
+}
+
+bool BrushControls::pickSwatch(std::size_t i) {
+  if (i >= swatches_.size()) return false;
+  swatch_ = i;
+  artist_ = swatches_[i];
+  channel_ = BrushChannel::Colour;
+  mode_ = BrushMode::Set;
+  return true;
+}
+
+void BrushControls::selectColourChannel() {
+  channel_ = BrushChannel::Colour;
+  mode_ = BrushMode::Set;
+}
+
+void BrushControls::cycleSwatch(int direction) {
+  const std::size_t n = swatches_.size();
+  if (n == 0) return;
+  pickSwatch((swatch_ + (direction >= 0 ? 1 : n - 1)) % n);
+}
+
+const char* BrushControls::artistFieldName(int field) {
+  return field == 0 ? "colour" : field == 1 ? "scatter distance" : "g";
+}
+
+std::string BrushControls::artistFieldText(int field) const {
+  char text[96];
+  if (field == 2) {
+    std::snprintf(text, sizeof text, "%.6g", artist_.g);
+  } else {
+    const glm::dvec3& v = field == 0 ? artist_.colour : artist_.scatterDistance;
+    if (v.x == v.y && v.y == v.z)
+      std::snprintf(text, sizeof text, "%.6g", v.x);
+    else
+      std::snprintf(text, sizeof text, "%.6g, %.6g, %.6g", v.x, v.y, v.z);
+  }
+  return text;
+}
+
+std::string BrushControls::enterArtistField(int field, const std::string& text) {
+  const std::vector<double> values = parseNumbers(text);
+  const bool scalarOnly = field == 2;
+  if (values.empty() || (values.size() != 1 && (scalarOnly || values.size() != 3)))
+    return std::string(artistFieldName(field)) + ": expected " + (scalarOnly ? "one number" : "one number or three") +
+           ", got \"" + text + "\"";
+  ArtistParams next = artist_;
+  const glm::dvec3 v = values.size() == 1 ? glm::dvec3(values[0]) : glm::dvec3(values[0], values[1], values[2]);
+  if (field == 0) next.colour = v;
+  else if (field == 1) next.scatterDistance = v;
+  else next.g = values[0];
+  if (std::string problem = artistParamsProblem(next, ior_); !problem.empty()) return problem;
+  for (int c = 0; c < 3; ++c)
+    if (next.scatterDistance[c] > kMaxScatterDistance)
+      return "scatter_distance[" + std::to_string(c) + "]: the editor takes at most 1e30";
+  artist_ = next;
+  channel_ = BrushChannel::Colour;
+  mode_ = BrushMode::Set;
+  return {};
 }
 
 void BrushControls::cycleComponent() { component_ = component_ >= 2 ? -1 : component_ + 1; }
@@ -211,7 +331,8 @@ void BrushControls::adjustDepth(int direction) {
 std::string BrushControls::describe() const {
   const Brush b = brush();
   std::string text = std::string(paintMode_ ? "PAINT" : "CAMERA") + " | " + channelName(channel_) + " " + modeName(mode_);
-  const char* components[] = {"r", "g", "b"};
+  // Spelled out: "(editing g)" would read as the phase function's g.
+  const char* components[] = {"red", "green", "blue"};
   const std::string per = " /" + units_;
   switch (channel_) {
     case BrushChannel::SigmaT:
@@ -231,6 +352,12 @@ std::string BrushControls::describe() const {
     case BrushChannel::Preset:
       text += " " + b.preset;
       break;
+    case BrushChannel::Colour: {
+      char g[64];
+      std::snprintf(g, sizeof g, " g %.3g", b.artist.g);
+      text += " " + formatRgb(b.artist.colour) + " dist " + formatRgb(b.artist.scatterDistance) + " " + units_ + g;
+      break;
+    }
     case BrushChannel::All:
       break;
   }
@@ -248,11 +375,21 @@ std::string BrushControls::describe() const {
   return text;
 }
 
+std::string BrushControls::describeStored() const {
+  if (channel_ != BrushChannel::Colour) return {};
+  const MaterialSample m = artistToPhysical(artist_, ior_);
+  char g[48];
+  std::snprintf(g, sizeof g, ", g %.3g", double(m.g));
+  return "stores sigma_t " + formatRgb(glm::dvec3(m.sigmaT)) + " sigma_s " + formatRgb(glm::dvec3(m.sigmaS)) + " /" +
+         units_ + g;
+}
+
 std::string BrushControls::displayChannel() const {
   switch (channel_) {
     case BrushChannel::SigmaS: return "sigma_s";
     case BrushChannel::G: return "g";
-    case BrushChannel::AlbedoMfp: return "albedo";
+    case BrushChannel::AlbedoMfp:
+    case BrushChannel::Colour: return "albedo";
     default: return "sigma_t";
   }
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "editor/brush_engine.h"
 
@@ -16,23 +17,49 @@ namespace sslpv {
 
 class BrushControls {
  public:
-  /// Defaults from the scene: set targets start at the base material (σt doubled, so a
-  /// first stroke is visible), radius at 8 % of the object's longest world extent.
-  BrushControls(const MaterialSample& basePerSceneUnit, double objectWorldExtent, std::string sceneUnits);
+  /// Defaults from the scene: set targets start at the base material (σt doubled, the
+  /// colour halved, so a first stroke is visible), radius at 8 % of the object's longest
+  /// world extent. The first channel is the artist's one: surface colour, scatter distance
+  /// and g (volume/artist_params.h), seen through the scene's boundary index `ior`.
+  BrushControls(const MaterialSample& basePerSceneUnit, double objectWorldExtent, std::string sceneUnits,
+                double ior = 1.0);
 
   /// The brush the next stroke uses (always passes brushProblem()).
   Brush brush() const;
 
-  void cycleChannel(int direction);  ///< sigma_t, sigma_s, g, albedo_mfp, preset, all
+  void cycleChannel(int direction);  ///< colour, sigma_t, sigma_s, g, albedo_mfp, preset, all
   void cycleMode(int direction);     ///< only the modes the channel accepts
   void cycleFalloff();
   void scaleRadius(double factor);
   void adjustStrength(double delta);
-  /// The channel's main number one notch up (+1) or down (-1): σ values and mean free
-  /// paths by a factor 1.25, g by 0.05, a preset to the next/previous Jensen material.
+  /// The channel's main number one notch up (+1) or down (-1): σ values, mean free paths
+  /// and scatter distances by a factor 1.25, g by 0.05, a preset to the next/previous
+  /// Jensen material.
   void adjustValue(int direction);
-  /// albedo_mfp: the albedo of the selected component(s) by 0.02.
+  /// albedo_mfp: the albedo of the selected component(s) by 0.02; colour: the surface
+  /// colour by 0.02, within [0, the brightest the scene's ior allows].
   void adjustAlbedo(int direction);
+  /// colour: g by 0.05 within [-0.99, 0.99]; other channels: nothing.
+  void adjustArtistG(int direction);
+
+  /// The colour swatches: the Jensen materials as surface colour, scatter distance (scene
+  /// units) and g = 0 at the scene's ior, in measuredMaterials() order.
+  const std::vector<ArtistParams>& swatches() const { return swatches_; }
+  std::string swatchName(std::size_t i) const;
+  /// Picks swatch i (colour channel; switches to it). False when i is out of range.
+  bool pickSwatch(std::size_t i);
+  /// The next (+1) / previous (-1) swatch after the last one picked.
+  void cycleSwatch(int direction);
+  /// Typed entry of the colour channel's fields: 0 colour, 1 scatter distance, 2 g; text is
+  /// one number or three separated by commas or spaces (g: one). Returns "" when applied,
+  /// else why not ("colour[1]: must be in [0, 0.96], got 1.2"); nothing changes then.
+  std::string enterArtistField(int field, const std::string& text);
+  /// The field's current value as enterArtistField reads it ("0.8, 0.4, 0.2").
+  std::string artistFieldText(int field) const;
+  static const char* artistFieldName(int field);  ///< "colour", "scatter distance", "g"
+  const ArtistParams& artist() const { return artist_; }
+  void selectColourChannel();  ///< the colour channel, mode set, values unchanged
+  double ior() const { return ior_; }
   /// Which RGB component adjustValue/adjustAlbedo change: all, then r, g, b.
   void cycleComponent();
   void negateValue();  ///< add mode: paint the opposite amount
@@ -44,7 +71,11 @@ class BrushControls {
 
   /// One status line: "sigma_t set [1.2 1.5 2] /mm | radius 1.5 mm | smooth | ...".
   std::string describe() const;
-  /// What the slice views show for this brush: "sigma_t", "sigma_s", "g" or "albedo".
+  /// The colour brush's other view, what the grids will hold: "stores sigma_t [..] sigma_s
+  /// [..] /mm, g 0.3" ("" for the other channels, whose values are σ already).
+  std::string describeStored() const;
+  /// What the slice views show for this brush: "sigma_t", "sigma_s", "g" or "albedo"
+  /// (colour: "albedo", σs/σt, the closest of the four to what it sets).
   std::string displayChannel() const;
 
  private:
@@ -52,13 +83,17 @@ class BrushControls {
   glm::dvec3& rgbValue();
   double& scalarValue();
 
-  BrushChannel channel_ = BrushChannel::SigmaT;
+  BrushChannel channel_ = BrushChannel::Colour;
   BrushMode mode_ = BrushMode::Set;
   std::map<Key, glm::dvec3> rgb_;
   std::map<Key, double> scalar_;
   glm::dvec3 albedo_{0.9};
   glm::dvec3 meanFreePath_{1.0};
   std::size_t preset_ = 0;
+  ArtistParams artist_;
+  double ior_ = 1.0;
+  std::vector<ArtistParams> swatches_;
+  std::size_t swatch_ = 0;
   int component_ = -1;  ///< -1: all three
   double radius_ = 1.0;
   BrushFalloff falloff_ = BrushFalloff::Smooth;

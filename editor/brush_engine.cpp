@@ -65,6 +65,14 @@ void BrushEngine::Impl::resolve(const Brush& b) {
       r.drive[6] = true;
       r.value[6] = b.scalar;
       break;
+    case BrushChannel::Colour: {
+      const MaterialSample m = artistToPhysical(b.artist, target.ior);
+      driveRgb(0, glm::dvec3(m.sigmaT), true);
+      driveRgb(3, glm::dvec3(m.sigmaS), true);
+      r.drive[6] = true;
+      r.value[6] = b.artist.g;
+      break;
+    }
     case BrushChannel::AlbedoMfp: {
       const glm::dvec3 sigmaT = 1.0 / b.meanFreePath;
       driveRgb(0, sigmaT, true);

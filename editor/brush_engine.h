@@ -34,10 +34,13 @@
 // with x' = target / avg / base exactly when t = 1 (set, smooth, erase). Arithmetic is in
 // double; the result is stored as float.
 //
-// Channels: sigma_t (σt, RGB), sigma_s (σs, RGB), g; albedo_mfp drives σt and σs with the
-// targets σt = 1 / mean_free_path, σs = albedo · σt; preset drives σt, σs (Jensen 2001,
-// valid with g = 0) and g (target 0); All (smooth, erase only) drives σt, σs and g.
-// albedo_mfp and preset take mode set only; add and multiply need sigma_t, sigma_s or g.
+// Channels: sigma_t (σt, RGB), sigma_s (σs, RGB), g; Colour (the artist's form: surface
+// colour, scatter distance and g, volume/artist_params.h) drives σt, σs and g with the
+// targets artistToPhysical gives behind the target's boundary index; albedo_mfp drives σt
+// and σs with the targets σt = 1 / mean_free_path, σs = albedo · σt; preset drives σt, σs
+// (Jensen 2001, valid with g = 0) and g (target 0); All (smooth, erase only) drives σt, σs
+// and g. Colour, albedo_mfp and preset take mode set only; add and multiply need sigma_t,
+// sigma_s or g.
 // σ values (targets, add values) are per scene unit like the scene's base material and are
 // converted to the set's units; radius and depth are world lengths.
 //
@@ -76,6 +79,7 @@
 #include <string>
 #include <vector>
 
+#include "volume/artist_params.h"
 #include "volume/material.h"
 #include "volume/material_set.h"
 #include "volume/mesh.h"
@@ -84,7 +88,7 @@ namespace sslpv {
 
 struct Scene;
 
-enum class BrushChannel { SigmaT, SigmaS, G, AlbedoMfp, Preset, All };
+enum class BrushChannel { SigmaT, SigmaS, G, AlbedoMfp, Preset, All, Colour };
 enum class BrushMode { Set, Add, Multiply, Smooth, Erase };
 enum class BrushFalloff { Constant, Linear, Smooth, Gaussian };
 
@@ -107,6 +111,9 @@ struct Brush {
   glm::dvec3 albedo{1.0};        ///< albedo_mfp: in [0, 1]
   glm::dvec3 meanFreePath{1.0};  ///< albedo_mfp: > 0, scene units
   std::string preset;            ///< preset: a Jensen 2001 material name
+  /// Colour: surface colour, scatter distance (scene units) and g. The colour's upper
+  /// bound depends on the target's ior, so the engine checks it, not brushProblem.
+  ArtistParams artist;
   double radius = 1.0;           ///< world units, > 0
   BrushFalloff falloff = BrushFalloff::Smooth;
   double strength = 1.0;  ///< [0, 1]
@@ -158,6 +165,9 @@ struct PaintTarget {
   glm::dmat4 restToWorld{1.0};                    ///< the scene transform (similarity)
   Bounds restBounds;                              ///< the object's rest-space bounds (default mirror plane)
   std::shared_ptr<const TriangleMesh> worldMesh;  ///< for ray strokes; may be null
+  /// The object's boundary index (the scene's material.ior): what Colour brushes' surface
+  /// colour is seen through.
+  double ior = 1.0;
 };
 
 /// Voxels per side of the longest rest-space extent when a scene has no material set.

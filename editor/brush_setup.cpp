@@ -44,6 +44,10 @@ std::string brushProblem(const Brush& b) {
     case BrushChannel::All:
       if (valued) return "channel: mode set, add and multiply need a channel";
       return {};
+    case BrushChannel::Colour:
+      if (b.mode != BrushMode::Set) return "mode: the colour form takes mode set only";
+      // Checked at the largest bound any ior allows; the engine checks its own ior's.
+      return artistParamsProblem(b.artist, 1.0);
     case BrushChannel::AlbedoMfp:
     case BrushChannel::Preset:
       if (b.mode != BrushMode::Set) return "mode: channels albedo_mfp and preset take mode set only";
@@ -109,6 +113,7 @@ PaintTarget makePaintTarget(const Scene& scene) {
   requireClosedMesh(mesh);
   target.base = scene.material.base;
   target.sceneUnitInMm = scene.unitInMm;
+  target.ior = scene.material.ior;
   target.worldMesh = std::make_shared<const TriangleMesh>(std::move(mesh));
   if (scene.material.vdb) {
     const std::shared_ptr<const MaterialSet> loaded = loadMaterialSet(*scene.material.vdb);

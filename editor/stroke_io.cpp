@@ -89,21 +89,73 @@ void parseValue(const Reader& in, const json& v, const std::string& path, Brush&
       if (!presetMaterial(b.preset, 0.0f, 1.0))
         in.fail(path, "unknown preset \"" + printable(b.preset) + "\" (accepted: " + presetNames() + ")");
       break;
+    case BrushChannel::Colour:
     case BrushChannel::All:
       break;
   }
 }
 
-Stroke parseStroke(const Reader& in, const json& node, const std::string& path) {
+/// The artist's form of a set stroke: "colour" (or "color") + "scatter_distance" (+ "g")
+/// instead of "channel" + "value". Returns whether the stroke uses it; exactly one form.
+/// `bare`, when given, is the material of a stroke that names none (no "channel", "value"
+/// or colour-form key, mode "set" or absent).
+bool parseArtistForm(const Reader& in, const json& node, const std::string& path, Brush& b,
+                     const ArtistParams* bare) {
+  const json* colour = in.optional(node, "colour");
+  const json* color = in.optional(node, "color");
+  const json* distance = in.optional(node, "scatter_distance");
+  const json* g = in.optional(node, "g");
+  if (!colour && !color && !distance && !g) {
+    const json* mode = in.optional(node, "mode");
+    if (!bare || in.optional(node, "channel") || in.optional(node, "value") ||
+        (mode && !(mode->is_string() && mode->get<std::string>() == "set")))
+      return false;
+    b.channel = BrushChannel::Colour;
+    b.mode = BrushMode::Set;
+    b.artist = *bare;
+    return true;
+  }
+  if (colour && color) in.fail(childPath(path, "color"), "duplicates \"colour\" (give one spelling)");
+  const char* colourKey = colour ? "colour" : "color";
+  if (!colour) colour = color;
+  for (const char* key : {"channel", "value"})
+    if (in.optional(node, key))
+      in.fail(childPath(path, key), "a stroke gives either \"colour\" + \"scatter_distance\" (+ \"g\") or "
+                                    "\"channel\" + \"value\", not both");
+  if (!colour)
+    in.fail(path, std::string("missing required key \"colour\" (\"") + (distance ? "scatter_distance" : "g") +
+                      "\" belongs to the colour form)");
+  if (!distance) in.fail(path, "missing required key \"scatter_distance\" (\"" + std::string(colourKey) + "\" needs one)");
+  b.channel = BrushChannel::Colour;
+  b.mode = BrushMode::Set;
+  b.artist.colour = in.rgb(*colour, childPath(path, colourKey), 0.0, 1.0, "a surface colour in [0, 1]");
+  b.artist.scatterDistance =
+      in.rgb(*distance, childPath(path, "scatter_distance"), kMinScatterDistance, kInf, "a distance >= 1e-36");
+  b.artist.g = 0.0;
+  if (g) {
+    b.artist.g = in.number(*g, childPath(path, "g"));
+    if (!(std::abs(b.artist.g) <= kArtistMaxG))
+      in.fail(childPath(path, "g"), "must be in [-0.99, 0.99], got " + formatNumber(b.artist.g));
+  }
+  return true;
+}
+
+Stroke parseStroke(const Reader& in, const json& node, const std::string& path, const ArtistParams* bare) {
   in.requireObject(node, path);
   in.allowOnly(node, path,
-               {"channel", "mode", "value", "radius", "falloff", "strength", "mirror", "points", "rays", "depth"});
+               {"channel", "mode", "value", "colour", "color", "scatter_distance", "g", "radius", "falloff",
+                "strength", "mirror", "points", "rays", "depth"});
   Stroke stroke;
   Brush& b = stroke.brush;
-  b.mode = in.choice(in.required(node, path, "mode"), childPath(path, "mode"), "mode", kModeNames);
+  const bool artist = parseArtistForm(in, node, path, b, bare);
+  if (const json* v = in.optional(node, "mode"); v || !artist)
+    b.mode = in.choice(in.required(node, path, "mode"), childPath(path, "mode"), "mode", kModeNames);
   const bool valued = b.mode == BrushMode::Set || b.mode == BrushMode::Add || b.mode == BrushMode::Multiply;
   const char* modeName = nameOf(kModeNames, b.mode);
-  if (const json* v = in.optional(node, "channel")) {
+  if (artist) {
+    if (b.mode != BrushMode::Set)
+      in.fail(childPath(path, "mode"), std::string("the colour form takes mode \"set\" only, got \"") + modeName + "\"");
+  } else if (const json* v = in.optional(node, "channel")) {
     b.channel = in.choice(*v, childPath(path, "channel"), "channel", kChannelNames);
   } else if (valued) {
     in.fail(path, std::string("missing required key \"channel\" (mode \"") + modeName + "\" needs one)");
@@ -111,10 +163,10 @@ Stroke parseStroke(const Reader& in, const json& node, const std::string& path) 
   if ((b.channel == BrushChannel::AlbedoMfp || b.channel == BrushChannel::Preset) && b.mode != BrushMode::Set)
     in.fail(childPath(path, "mode"), std::string("channel \"") + nameOf(kChannelNames, b.channel) +
                                          "\" takes mode \"set\" only, got \"" + modeName + "\"");
-  if (const json* v = in.optional(node, "value")) {
+  if (const json* v = artist ? nullptr : in.optional(node, "value")) {
     if (!valued) in.fail(childPath(path, "value"), std::string("not used by mode \"") + modeName + "\" (remove it)");
     parseValue(in, *v, childPath(path, "value"), b);
-  } else if (valued) {
+  } else if (valued && !artist) {
     in.fail(path, std::string("missing required key \"value\" (mode \"") + modeName + "\" needs one)");
   }
   const std::string radiusPath = childPath(path, "radius");
@@ -177,7 +229,7 @@ nlohmann::ordered_json rgbJson(const glm::dvec3& v) { return nlohmann::ordered_j
 
 }  // namespace
 
-std::vector<Stroke> parseStrokes(const std::string& jsonText, const fs::path& file) {
+std::vector<Stroke> parseStrokes(const std::string& jsonText, const fs::path& file, const ArtistParams* bare) {
   if (jsonText.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(file.string() + ": empty file");
   JsonPathTracker tracker(file);
   json root;
@@ -200,12 +252,12 @@ std::vector<Stroke> parseStrokes(const std::string& jsonText, const fs::path& fi
   if (!strokes.is_array()) in.fail("strokes", "expected an array of strokes, got " + describeType(strokes));
   std::vector<Stroke> result;
   for (std::size_t i = 0; i < strokes.size(); ++i)
-    result.push_back(parseStroke(in, strokes[i], indexPath("strokes", i)));
+    result.push_back(parseStroke(in, strokes[i], indexPath("strokes", i), bare));
   return result;
 }
 
-std::vector<Stroke> loadStrokes(const fs::path& file) {
-  return parseStrokes(readInputFile(file, "stroke file"), file);
+std::vector<Stroke> loadStrokes(const fs::path& file, const ArtistParams* bare) {
+  return parseStrokes(readInputFile(file, "stroke file"), file, bare);
 }
 
 std::string formatStrokes(const std::vector<Stroke>& strokes) {
@@ -214,9 +266,14 @@ std::string formatStrokes(const std::vector<Stroke>& strokes) {
   for (const Stroke& stroke : strokes) {
     const Brush& b = stroke.brush;
     ojson s = ojson::object();
-    if (b.channel != BrushChannel::All) s["channel"] = nameOf(kChannelNames, b.channel);
+    if (b.channel != BrushChannel::All && b.channel != BrushChannel::Colour)
+      s["channel"] = nameOf(kChannelNames, b.channel);
     s["mode"] = nameOf(kModeNames, b.mode);
-    if (b.mode == BrushMode::Set || b.mode == BrushMode::Add || b.mode == BrushMode::Multiply) {
+    if (b.channel == BrushChannel::Colour) {
+      s["colour"] = rgbJson(b.artist.colour);
+      s["scatter_distance"] = rgbJson(b.artist.scatterDistance);
+      s["g"] = b.artist.g;
+    } else if (b.mode == BrushMode::Set || b.mode == BrushMode::Add || b.mode == BrushMode::Multiply) {
       switch (b.channel) {
         case BrushChannel::SigmaT:
         case BrushChannel::SigmaS:
@@ -231,6 +288,7 @@ std::string formatStrokes(const std::vector<Stroke>& strokes) {
         case BrushChannel::Preset:
           s["value"] = b.preset;
           break;
+        case BrushChannel::Colour:
         case BrushChannel::All:
           break;
       }

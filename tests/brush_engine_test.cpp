@@ -342,6 +342,10 @@ TEST(BrushEngine, RandomStrokesKeepEveryVoxelValid) {
     const bool valued = b.mode == BrushMode::Set || b.mode == BrushMode::Add || b.mode == BrushMode::Multiply;
     b.channel =
         valued ? BrushChannel(pick(b.mode == BrushMode::Set ? 5 : 3)) : BrushChannel(pick(4) == 3 ? 5 : pick(3));
+    if (b.mode == BrushMode::Set && pick(6) == 0) b.channel = BrushChannel::Colour;
+    b.artist.colour = glm::dvec3(unit(rng), unit(rng), unit(rng));
+    b.artist.scatterDistance = glm::dvec3(value(false) + 1e-6, 1e-3 + unit(rng), 0.5);
+    b.artist.g = 1.98 * unit(rng) - 0.99;
     b.rgb =
         glm::dvec3(value(b.mode == BrushMode::Add), value(b.mode == BrushMode::Add), value(b.mode == BrushMode::Add));
     b.scalar = b.mode == BrushMode::Set ? 1.98 * unit(rng) - 0.99 : value(true);
@@ -503,10 +507,18 @@ TEST(StrokeIo, FormatThenParseGivesTheSameStrokes) {
   a.mirror = BrushMirror{2, 0.125};
   Brush b = makeBrush(BrushChannel::All, BrushMode::Smooth, 2, BrushFalloff::Linear, 0.5);
   b.depth = 0.75;
+  Brush c = makeBrush(BrushChannel::Colour, BrushMode::Set, 1, BrushFalloff::Smooth, 1);
+  c.artist = {glm::dvec3(0.1, 1.0 / 3.0, 0.9), glm::dvec3(0.25, 2, 1e-3), -0.3};
   const std::vector<Stroke> strokes = {{a, {glm::dvec3(1, 2, 3), glm::dvec3(0.1, -0.2, 1e-9)}, {}},
-                                       {b, {}, {{glm::dvec3(0, 0, 5), glm::dvec3(0, 0.1, -1)}}}};
+                                       {b, {}, {{glm::dvec3(0, 0, 5), glm::dvec3(0, 0.1, -1)}}},
+                                       {c, {glm::dvec3(0.5)}, {}}};
   const std::vector<Stroke> back = parseStrokes(formatStrokes(strokes), "round.json");
-  ASSERT_EQ(back.size(), 2u);
+  ASSERT_EQ(back.size(), 3u);
+  EXPECT_EQ(back[2].brush.channel, BrushChannel::Colour);
+  EXPECT_EQ(back[2].brush.mode, BrushMode::Set);
+  EXPECT_EQ(back[2].brush.artist.colour, c.artist.colour);
+  EXPECT_EQ(back[2].brush.artist.scatterDistance, c.artist.scatterDistance);
+  EXPECT_EQ(back[2].brush.artist.g, -0.3);
   EXPECT_EQ(back[0].brush.radius, a.radius);
   EXPECT_EQ(back[0].brush.strength, a.strength);
   EXPECT_EQ(back[0].brush.meanFreePath, a.meanFreePath);

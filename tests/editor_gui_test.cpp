@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "test_support.h"
+#include "volume/adding_doubling.h"
 #include "volume/image_io.h"
+#include "volume/material.h"
 #include "volume/material_set.h"
 #include "volume/scene.h"
 
@@ -56,6 +58,15 @@ class EventScript {
     return *this;
   }
   EventScript& ctrl(char letter) { return key(std::string(1, letter), letter - 'a' + 1, 2); }
+  /// Typed text of digits, '.', ',' and '-', then Enter.
+  EventScript& type(const std::string& text) {
+    for (char c : text) {
+      const std::string sym = c == '.' ? "period" : c == ',' ? "comma" : c == '-' ? "minus" : std::string(1, c);
+      key(sym, c);
+    }
+    return key("Return", 13);
+  }
+  EventScript& click(int x, int y) { return drag(x, y, x, y, 0); }
   EventScript& wheelForward(int x, int y, int times) {
     for (int i = 0; i < times; ++i) event("MouseWheelForwardEvent", x, y);
     return *this;
@@ -130,7 +141,9 @@ TEST(EditorGui, PaintSurfaceAndSliceThenSaveMatchesGoldenScreenshot) {
   // painted σt between the base and the brush's set target (set mode moves towards it).
   if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
   Project p;
-  test::writeText(p.events, EventScript().drag(200, 402, 280, 402, 8).drag(760, 117, 840, 117, 8).ctrl('s').str());
+  // c: from the colour brush to sigma_t, the brush this picture was made with.
+  test::writeText(p.events,
+                  EventScript().key("c", 'c').drag(200, 402, 280, 402, 8).drag(760, 117, 840, 117, 8).ctrl('s').str());
   const fs::path shot = p.dir / "actual.png";
   const RunResult r =
       runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--screenshot", shot.string(), "--exit"});
@@ -245,6 +258,81 @@ TEST(EditorGui, QuitAsksBeforeDroppingUnsavedWork) {
   ASSERT_EQ(r.exitCode, 0) << r.stderrText;
   EXPECT_FALSE(fs::exists(p.recovery)) << "quitting without saving should not leave a recovery file";
   EXPECT_FALSE(fs::exists(p.saved));
+}
+
+/// Every active voxel of the saved set shows `colour` behind `ior` within 1 % (adding-doubling
+/// of α' from the stored floats) at scatter distance `distance` and phase g; returns how many.
+std::size_t expectVoxelsShowColour(const fs::path& vdb, const glm::dvec3& colour, const glm::dvec3& distance, double g,
+                                   double ior) {
+  const auto set = loadMaterialSet(vdb);
+  auto s = set->sigmaS->getConstAccessor();
+  auto gs = set->g->getConstAccessor();
+  std::size_t voxels = 0;
+  for (auto it = set->sigmaT->cbeginValueOn(); it; ++it, ++voxels) {
+    const openvdb::Vec3s sigmaT = *it, sigmaS = s.getValue(it.getCoord());
+    const double vg = gs.getValue(it.getCoord());
+    EXPECT_NEAR(vg, g, 1e-6) << it.getCoord();
+    for (int c = 0; c < 3; ++c) {
+      const double reducedT = sigmaT[c] - sigmaS[c] * vg;
+      const double rd = addingDoublingHalfSpace(sigmaS[c] * (1.0 - vg) / reducedT, ior).rd;
+      EXPECT_NEAR(rd, colour[c], 0.01 * colour[c]) << it.getCoord() << " channel " << c;
+      EXPECT_NEAR(1.0 / reducedT, distance[c], 1e-4 * distance[c]) << it.getCoord() << " channel " << c;
+      if (::testing::Test::HasFailure()) return voxels;
+    }
+  }
+  return voxels;
+}
+
+/// Strength 1 (= ten times) and constant falloff (o: smooth -> gaussian -> constant), so
+/// every voxel a dab reaches holds the brush's material exactly.
+EventScript& fullStrength(EventScript& events) {
+  for (int i = 0; i < 10; ++i) events.key("equal", '=');
+  return events.key("o", 'o').key("o", 'o');
+}
+
+TEST(EditorGui, TypedColourPaintsVoxelsThatShowIt) {
+  // Enter, then the surface colour, the scatter distance and g typed in; a stroke at full
+  // strength; Ctrl+S. The painted voxels show the typed colour behind the scene's ior 1.3.
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  Project p;
+  std::string scene = kScene;
+  scene.replace(scene.find("\"g\": 0.0}"), 9, "\"g\": 0.0}, \"ior\": 1.3");
+  test::writeText(p.scene, scene);
+  EventScript events;
+  events.key("Return", 13).type("0.7,0.3,0.1").type("2").type("0.3");
+  fullStrength(events).drag(200, 402, 280, 402, 8).ctrl('s');
+  test::writeText(p.events, events.str());
+  const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--exit"});
+  ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  ASSERT_TRUE(fs::exists(p.saved)) << r.stderrText;
+  EXPECT_GT(expectVoxelsShowColour(p.saved, {0.7, 0.3, 0.1}, glm::dvec3(2.0), 0.3, 1.3), 100u);
+}
+
+TEST(EditorGui, ClickedSwatchPaintsItsMaterial) {
+  // A click on the third swatch (under the 3D view) picks that Jensen material; the stroke
+  // paints its σt and σs (g = 0), index-matched scene.
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  Project p;
+  EventScript events;
+  // Swatch i spans x from (0.003 + i / 24) * 960; the row's text sits just above y = 0.345 * 600.
+  events.click(int((0.003 + 2.0 / 24.0) * 960.0) + 8, int(0.345 * 600.0) + 5);
+  fullStrength(events).drag(200, 402, 280, 402, 8).ctrl('s');
+  test::writeText(p.events, events.str());
+  const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--exit"});
+  ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  ASSERT_TRUE(fs::exists(p.saved)) << r.stderrText;
+  const MeasuredMaterial& m = measuredMaterials()[2];
+  const MaterialSample preset = *presetMaterial(m.name, 0.0f, 1.0);
+  const auto set = loadMaterialSet(p.saved);
+  auto s = set->sigmaS->getConstAccessor();
+  std::size_t voxels = 0;
+  for (auto it = set->sigmaT->cbeginValueOn(); it; ++it, ++voxels) {
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR((*it)[c], preset.sigmaT[c], 1e-4 * preset.sigmaT[c]) << m.name << " at " << it.getCoord();
+      ASSERT_NEAR(s.getValue(it.getCoord())[c], preset.sigmaS[c], 1e-4 * preset.sigmaS[c]) << m.name;
+    }
+  }
+  EXPECT_GT(voxels, 100u) << "the swatch click must not paint, the stroke must";
 }
 
 // Fraction of pixels in [x0, x1) x [y0, y1) (image rows from the top) whose largest

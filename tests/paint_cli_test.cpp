@@ -13,6 +13,7 @@
 #include "editor/brush_engine.h"
 #include "editor/stroke_io.h"
 #include "test_support.h"
+#include "volume/adding_doubling.h"
 #include "volume/material_set.h"
 #include "volume/scene.h"
 
@@ -254,6 +255,131 @@ TEST(PaintCli, AStrokeWhoseTotalWorkIsTooLargeIsRefusedBeforeItStarts) {
   EXPECT_EQ(run.exitCode, 2) << run.stderrText;
   EXPECT_NE(run.stderrText.find("strokes[0].radius: the stroke's"), std::string::npos) << run.stderrText;
   EXPECT_NE(run.stderrText.find("more than the limit of 2^30"), std::string::npos) << run.stderrText;
+}
+
+/// Every active voxel of `set` (σ per scene unit: the scene's units) shows `colour` within
+/// 1 % by adding-doubling at `ior` (α' from the stored floats), and `distance` as 1/σt'.
+void expectPaintedColour(const MaterialSet& set, const glm::dvec3& colour, const glm::dvec3& distance, double g,
+                         double ior, std::size_t minVoxels) {
+  ASSERT_TRUE(set.g);
+  auto s = set.sigmaS->getConstAccessor();
+  auto gs = set.g->getConstAccessor();
+  std::size_t voxels = 0;
+  for (auto it = set.sigmaT->cbeginValueOn(); it; ++it, ++voxels) {
+    const openvdb::Vec3s sigmaT = *it, sigmaS = s.getValue(it.getCoord());
+    const double vg = gs.getValue(it.getCoord());
+    ASSERT_NEAR(vg, g, 1e-6) << it.getCoord();
+    for (int c = 0; c < 3; ++c) {
+      const double reducedT = sigmaT[c] - sigmaS[c] * vg;
+      const double rd = addingDoublingHalfSpace(sigmaS[c] * (1.0 - vg) / reducedT, ior).rd;
+      ASSERT_NEAR(rd, colour[c], 0.01 * colour[c]) << it.getCoord() << " channel " << c;
+      ASSERT_NEAR(1.0 / reducedT, distance[c], 1e-5 * distance[c]) << it.getCoord() << " channel " << c;
+    }
+  }
+  EXPECT_GE(voxels, minVoxels);
+}
+
+json sceneWithIor(double ior) {
+  json scene = sceneJson();
+  scene["material"]["ior"] = ior;
+  return scene;
+}
+
+// The colour form: a picked surface colour and scatter distance, painted at full strength,
+// leave voxels whose albedo shows that colour behind the scene's ior.
+TEST(PaintCli, AColourStrokePaintsVoxelsThatShowThePickedColour) {
+  Files f;
+  writeText(f.scene, sceneWithIor(1.4).dump());
+  const glm::dmat4 restToWorld = loadScene(f.scene).transform.matrix();
+  const glm::dvec3 colour(0.8, 0.35, 0.05), distance(2.0, 1.0, 0.5);
+  writeText(f.strokes, json({{"strokes",
+                              {{{"color", {colour.x, colour.y, colour.z}},
+                                {"scatter_distance", {distance.x, distance.y, distance.z}},
+                                {"g", 0.4},
+                                {"radius", 0.5},
+                                {"falloff", "constant"},
+                                {"points", {worldPoint(restToWorld, {1, 1, 1})}}}}}})
+                           .dump());
+  const RunResult run = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", f.output.string()});
+  ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+  expectPaintedColour(*loadMaterialSet(f.output), colour, distance, 0.4, 1.4, 50);
+}
+
+// The flags give the material of strokes that name none: one path file, any colour.
+TEST(PaintCli, ColourFlagsPaintStrokesThatNameNoMaterial) {
+  Files f;
+  writeText(f.scene, sceneWithIor(1.3).dump());
+  const glm::dmat4 restToWorld = loadScene(f.scene).transform.matrix();
+  writeText(f.strokes, json({{"strokes",
+                              {{{"radius", 0.5},
+                                {"falloff", "constant"},
+                                {"points", {worldPoint(restToWorld, {-1, 0, 2})}}}}}})
+                           .dump());
+  const RunResult run = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o",
+                                  f.output.string(), "--colour", "0.6,0.3,0.9", "--scatter-distance", "1.5"});
+  ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+  expectPaintedColour(*loadMaterialSet(f.output), {0.6, 0.3, 0.9}, glm::dvec3(1.5), 0.0, 1.3, 50);
+  // Without the flags the same file is refused as before.
+  const RunResult bare = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o",
+                                   (f.dir / "bare.vdb").string()});
+  EXPECT_EQ(bare.exitCode, 2);
+  EXPECT_NE(bare.stderrText.find("strokes[0]: missing required key \"mode\""), std::string::npos) << bare.stderrText;
+}
+
+TEST(PaintCli, BadColourStrokesAndFlagsExit2NamingTheKeyOrFlag) {
+  const json point = {{1, 2, 3}};
+  auto stroke = [&](json extra) {
+    json s = {{"radius", 1}, {"points", point}};
+    s.update(extra);
+    return json({{"strokes", {s}}});
+  };
+  const std::vector<std::pair<json, std::string>> strokeCases = {
+      {stroke({{"colour", 0.5}, {"scatter_distance", 1}, {"channel", "sigma_t"}}),
+       "strokes[0].channel: a stroke gives either \"colour\""},
+      {stroke({{"colour", 0.5}, {"color", 0.5}, {"scatter_distance", 1}}), "strokes[0].color: duplicates \"colour\""},
+      {stroke({{"colour", 0.5}}), "strokes[0]: missing required key \"scatter_distance\""},
+      {stroke({{"scatter_distance", 1}}), "strokes[0]: missing required key \"colour\""},
+      {stroke({{"colour", {0.5, 1.5, 0.5}}, {"scatter_distance", 1}}), "strokes[0].colour[1]: must be a surface colour"},
+      {stroke({{"colour", 0.5}, {"scatter_distance", {1, 0, 1}}}), "strokes[0].scatter_distance[1]: must be"},
+      {stroke({{"colour", 0.5}, {"scatter_distance", 1}, {"g", 1}}), "strokes[0].g: must be in [-0.99, 0.99], got 1"},
+      {stroke({{"colour", 0.5}, {"scatter_distance", 1}, {"mode", "add"}}), "strokes[0].mode: the colour form takes"},
+      // Brighter than a non-absorbing medium behind the scene's ior 1.5 boundary shows:
+      // refused when painted, naming the channel, the value and the bound.
+      {stroke({{"colour", {0.5, 0.5, 0.97}}, {"scatter_distance", 1}}),
+       "strokes[0].colour[2]: must be in [0, 0.96], got 0.97"},
+  };
+  for (const auto& [strokes, expected] : strokeCases) {
+    Files f;
+    writeText(f.scene, sceneWithIor(1.5).dump());
+    writeText(f.strokes, strokes.dump());
+    const RunResult run = runSslpv({"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", f.output.string()});
+    EXPECT_EQ(run.exitCode, 2) << strokes.dump();
+    EXPECT_EQ(run.stderrText.rfind("sslpv: error: " + f.strokes.string() + ": " + expected, 0), 0u)
+        << run.stderrText << "expected: " << expected;
+    EXPECT_EQ(std::count(run.stderrText.begin(), run.stderrText.end(), '\n'), 1) << run.stderrText;
+    EXPECT_FALSE(fs::exists(f.output));
+  }
+  const std::vector<std::pair<std::vector<std::string>, std::string>> flagCases = {
+      {{"--g", "0.3"}, "--g: needs --colour"},
+      {{"--colour", "0.5"}, "--colour: needs --scatter-distance"},
+      {{"--colour", "0.5,0.2", "--scatter-distance", "1"}, "--colour: expected one number or R,G,B, got 2 numbers"},
+      {{"--colour", "0.5,x,0.2", "--scatter-distance", "1"}, "--colour: expected one number or R,G,B, got \"0.5,x,0.2\""},
+      {{"--colour", "0.99", "--scatter-distance", "1"}, "--colour[0]: must be in [0, 0.96], got 0.99"},
+      {{"--colour", "0.5", "--scatter-distance", "1,-1,1"}, "--scatter-distance[1]: must be positive"},
+      {{"--colour", "0.5", "--scatter-distance", "1", "--g", "-2"}, "--g: must be in [-0.99, 0.99], got -2"},
+  };
+  for (const auto& [flags, expected] : flagCases) {
+    Files f;
+    writeText(f.scene, sceneWithIor(1.5).dump());
+    writeText(f.strokes, stroke(json::object()).dump());
+    std::vector<std::string> args = {"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o",
+                                     f.output.string()};
+    args.insert(args.end(), flags.begin(), flags.end());
+    const RunResult run = runSslpv(args);
+    EXPECT_EQ(run.exitCode, 2) << expected;
+    EXPECT_EQ(run.stderrText.rfind("sslpv: error: " + expected, 0), 0u) << run.stderrText << "expected: " << expected;
+    EXPECT_FALSE(fs::exists(f.output));
+  }
 }
 
 TEST(PaintCli, BadOutputOrMissingStrokeFileExit2) {

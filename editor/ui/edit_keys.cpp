@@ -48,6 +48,12 @@ bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char k
     window_->Render();
     return true;
   }
+  if (colourEntryField_) {
+    handleColourEntryKey(key, keyCode);
+    updateStatus();
+    window_->Render();
+    return true;
+  }
   if (key != "q" && key != "e") quitArmed_ = false;
   const std::string lower = key.size() == 1 ? std::string(1, char(std::tolower(key[0]))) : key;
   bool handled = true;
@@ -93,6 +99,14 @@ bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char k
     controls_.adjustValue(key == "period" ? 1 : -1);
   } else if (key == "semicolon" || key == "apostrophe") {
     controls_.adjustAlbedo(key == "apostrophe" ? 1 : -1);
+  } else if (key == "g" || key == "G") {
+    if (controls_.brush().channel != BrushChannel::Colour) showMessage("g / G change the colour brush's g (c: channel)", false);
+    controls_.adjustArtistG(key == "g" ? 1 : -1);
+  } else if (key == "p" || key == "P") {
+    controls_.cycleSwatch(key == "p" ? 1 : -1);
+    updateSlices();
+  } else if (key == "Return" || key == "KP_Enter") {
+    startColourEntry();
   } else if (key == "v") {
     controls_.cycleComponent();
   } else if (key == "n") {

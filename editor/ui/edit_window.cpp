@@ -45,11 +45,14 @@ const char* kHelpText =
     "               slice views: paint on the slice plane\n"
     "  right/middle drag, wheel   camera (3D view); wheel over a slice moves it\n"
     "  Up / Down    move the slice under the mouse\n"
-    "  c / C        channel: sigma_t, sigma_s, g, albedo+mfp, preset, all\n"
+    "  c / C        channel: colour, sigma_t, sigma_s, g, albedo+mfp, preset, all\n"
     "  m / M        mode: set, add, multiply, smooth, erase\n"
-    "  , / .        value down / up (sigma x1.25, g 0.05, mfp x1.25, preset)\n"
-    "  ; / '        albedo down / up (albedo+mfp)\n"
-    "  v            edit all / r / g / b component of the value\n"
+    "  , / .        value down / up (sigma x1.25, g 0.05, mfp and scatter distance x1.25, preset)\n"
+    "  ; / '        albedo (albedo+mfp) or surface colour (colour) down / up\n"
+    "  g / G        colour: phase g up / down        p / P   next / previous swatch\n"
+    "  Enter        colour: type surface colour, scatter distance, g (Enter keeps a field)\n"
+    "  click        a swatch under the 3D view: paint that material's colour\n"
+    "  v            edit all / red / green / blue component of the value\n"
     "  n            negate the add amount\n"
     "  [ / ]        radius smaller / larger\n"
     "  - / =        strength down / up\n"
@@ -98,7 +101,7 @@ EditWindow::EditWindow(EditSession& session, const EditWindowOptions& options)
     : session_(session),
       options_(options),
       controls_(session.scene().material.base, glm::length(session.worldMesh().bounds().extent()) / std::sqrt(3.0),
-                session.scene().units) {
+                session.scene().units, session.scene().material.ior) {
   recoveryPending_ = options.offerRecovery && findRecoveryFile(session.scene().file).has_value();
   buildScene();
   updateSlices();
@@ -213,6 +216,7 @@ void EditWindow::buildScene() {
   help_->GetTextProperty()->SetBackgroundColor(0.0, 0.0, 0.0);
   help_->GetTextProperty()->SetBackgroundOpacity(0.85);
   help_->SetVisibility(false);
+  buildSwatches();
 }
 
 void EditWindow::updateSlices() {
@@ -259,6 +263,7 @@ void EditWindow::updatePreview() {
 
 void EditWindow::updateStatus() {
   status_->SetInput((controls_.describe() + "   | h: help").c_str());
+  updateSwatches();
   const bool unsaved = session_.unsaved();
   unsavedMarker_->SetInput(unsaved ? "* unsaved changes" : "saved");
   unsavedMarker_->GetTextProperty()->SetColor(unsaved ? 1.0 : 0.6, unsaved ? 0.6 : 0.6, unsaved ? 0.2 : 0.6);
@@ -308,6 +313,7 @@ bool EditWindow::beginPaint(int x, int y) {
   vtkRenderer* target = rendererAt(x, y);
   const std::optional<int> axis = slices_->axisOf(target);
   if (target != view3d_.Get() && !axis) return false;
+  if (pickSwatchAt(x, y)) return true;
   if (recoveryPending_) {
     showMessage("Answer the recovery question first: R recovers the earlier session's work, D discards it", true);
     window_->Render();

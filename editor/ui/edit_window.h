@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "editor/brush_controls.h"
 #include "editor/edit_session.h"
@@ -76,6 +77,14 @@ class EditWindow {
   void save();
   void startExportPrompt();
   bool handlePromptKey(const std::string& keySym, char keyCode);
+  // The colour picker (editor/ui/colour_panel.cpp).
+  void buildSwatches();
+  void updateSwatches();  ///< the brush swatch shows the brush's colour
+  /// Picks the swatch under display (x, y); false when there is none.
+  bool pickSwatchAt(int x, int y);
+  void startColourEntry();
+  void showColourEntry();
+  void handleColourEntryKey(const std::string& keySym, char keyCode);
   void maybeAutosave(bool strokeJustEnded);
   SurfaceRay rayAt(int x, int y) const;
   /// Shows the brush (a wire sphere of its radius) at the surface or slice point under
@@ -99,6 +108,7 @@ class EditWindow {
   vtkSmartPointer<vtkImageData> previewImage_;
   vtkSmartPointer<vtkImageActor> previewActor_;
   vtkSmartPointer<vtkTextActor> status_, message_, help_, unsavedMarker_, previewLabel_;
+  vtkSmartPointer<vtkTextActor> storedView_;  ///< the colour brush's σ view, beside the swatches
 
   PaintView paintView_ = PaintView::None;
   int paintAxis_ = 0;
@@ -107,6 +117,9 @@ class EditWindow {
   bool quitArmed_ = false;
   bool recoveryPending_ = false;
   std::optional<std::string> prompt_;  ///< export path being typed
+  std::vector<vtkSmartPointer<vtkTextActor>> swatchActors_;  ///< the Jensen swatches, then the brush's
+  std::optional<int> colourEntryField_;  ///< typed entry: 0 colour, 1 scatter distance, 2 g
+  std::string colourEntryText_;
   std::chrono::steady_clock::time_point lastChange_;
   std::string previewTiming_;
 };
