@@ -109,12 +109,17 @@ TEST(WarmStart, AStrokeOrANudgeReconvergesToTheColdTolerancesInFewerSteps) {
   for (int z = 9; z < 15; ++z)
     for (int y = 9; y < 15; ++y)
       for (int x = 1; x < 5; ++x) stroke.material.sigmaS[stroke.material.frame.index(x, y, z)] = glm::vec3(0.6f);
+  Slab deep = before;  // a large, much darker block deep inside
+  for (int z = 8; z < 16; ++z)
+    for (int y = 8; y < 16; ++y)
+      for (int x = 4; x < 20; ++x) deep.material.sigmaS[deep.material.frame.index(x, y, z)] = glm::vec3(0.3f);
   Slab nudge = before;  // the light 5 % brighter over half the face
   for (int z = 1; z < 12; ++z)
     for (int y = 1; y < 23; ++y)
       for (int ch = 0; ch < 3; ++ch) nudge.injected.plane(ch, 0)[nudge.material.frame.index(1, y, z)] *= 1.05f;
 
-  for (const auto& [name, changed] : {std::pair{"stroke", &stroke}, std::pair{"nudge", &nudge}}) {
+  for (const auto& [name, changed] :
+       {std::pair{"stroke", &stroke}, std::pair{"deep stroke", &deep}, std::pair{"nudge", &nudge}}) {
     PropagationWarmStart start = warm;
     PropagationOptions o = chebyshev;
     o.warmStart = &start;

@@ -94,6 +94,10 @@ struct PropagationWarmStart {
   /// reuses it instead of probing: an estimate off the new T's radius only converges more
   /// slowly, and the stop rule then follows the shrink it observes.
   glm::dvec3 rho{0.0};
+  /// Per cell of `frame`: an active cell within two cells of an inactive one, where the
+  /// shading reads the light (half a cell, at most one cell, inside the surface, trilinear).
+  /// Filled by the first warm run on the frame.
+  std::vector<unsigned char> shell;
   bool holds(const GridFrame& f) const {
     return !light[0].empty() && light[0].size() == f.cellCount() && frame.dims == f.dims &&
            frame.origin == f.origin && frame.cellSize == f.cellSize;
@@ -134,9 +138,10 @@ struct PropagationOptions {
   PropagationWarmStart* warmStart = nullptr;
   /// A warm start's error sits where the frame changed, where a share of the total that
   /// the usual stop lets through can be most of a region's light. So a warm run stops
-  /// only once, besides that, every cell's light still to come (its change, extrapolated
-  /// as the total's) is under this share of the cell's own light (cells under
-  /// SSLPV_WARM_START_LOCAL_FLOOR of the mean cell's, of that floor).
+  /// only once, besides that, the light still to come (its change, extrapolated as the
+  /// total's) in every cell the shading reads (PropagationWarmStart::shell) is under this
+  /// share of the cell's own light (for cells under SSLPV_WARM_START_LOCAL_FLOOR of the
+  /// mean cell's, of that floor). A cold run's worst cell is about as far off.
   double warmLocalTolerance = 1e-2;
 };
 

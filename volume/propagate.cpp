@@ -299,11 +299,12 @@ struct ChebyshevSums {
 /// A probe step is ω = 1 with sourceWeight 0, as lpv_propagate.comp's.
 using ChannelPlanes = std::array<std::vector<float>, 3>;  ///< one c0 plane per channel
 
-/// kLocal: also the largest change relative to the cell's own light, brighter than `floor`.
+/// kLocal: also the largest change relative to the cell's own light (or `floor`, where
+/// brighter) over the cells of `shell` (PropagationWarmStart::shell).
 template <bool kRetain, bool kConduct, bool kLocal>
 void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const ChannelPlanes& current,
                     ChannelPlanes& older, const ChannelPlanes& source, const glm::vec3& omega, float sourceWeight,
-                    const glm::vec3& floor, ChebyshevSums& s) {
+                    const glm::vec3& floor, const unsigned char* shell, ChebyshevSums& s) {
   const std::size_t sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
   for (int y = 1; y < f.dims.y - 1; ++y) {
     if (!factors.rowActive[std::size_t(z) * f.dims.y + y]) continue;
@@ -328,7 +329,8 @@ void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const
         out[i] = next;
         change += std::abs(next - x[i]);
         total += next;
-        if constexpr (kLocal) local = std::max(local, std::abs(next - x[i]) / std::max(std::abs(next), lightFloor));
+        if constexpr (kLocal)
+          local = std::max(local, (shell[i] ? std::abs(next - x[i]) : 0.0f) / std::max(std::abs(next), lightFloor));
       }
       s.change[ch] += double(change);
       s.total[ch] += double(total);
@@ -463,6 +465,30 @@ struct StallWatch {
   }
 };
 
+/// PropagationWarmStart::shell: the active cells within two cells (along every axis) of
+/// an inactive one, by a separable dilation of the inactive cells.
+std::vector<unsigned char> shadedShell(const GridFrame& f, const std::vector<unsigned char>& active) {
+  std::vector<unsigned char> near(active.size());
+  for (std::size_t i = 0; i < near.size(); ++i) near[i] = !active[i];
+  const std::size_t strides[3] = {1, std::size_t(f.dims.x), std::size_t(f.dims.x) * f.dims.y};
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<unsigned char> dilated(near.size(), 0);
+    for (int z = 0; z < f.dims.z; ++z)
+      for (int y = 0; y < f.dims.y; ++y)
+        for (int x = 0; x < f.dims.x; ++x) {
+          const int c[3] = {x, y, z};
+          const std::size_t i = f.index(x, y, z);
+          for (int d = -2; d <= 2 && !dilated[i]; ++d) {
+            const int at = c[axis] + d;
+            if (at >= 0 && at < f.dims[axis]) dilated[i] = near[std::size_t(std::ptrdiff_t(i) + d * std::ptrdiff_t(strides[axis]))];
+          }
+        }
+    near.swap(dilated);
+  }
+  for (std::size_t i = 0; i < near.size(); ++i) near[i] = near[i] && active[i];
+  return near;
+}
+
 /// Runs the semi-iteration for x = (I - T)^-1 y, y the light of the first step (in
 /// `field`, which ends holding the last iterate), adding x - y to `accumulated`, which
 /// already holds y. T is similar to a symmetric operator (T = S W (K + R) W / 6: survival,
@@ -484,6 +510,7 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   std::vector<ChebyshevSums> sums(f.dims.z);
   // Warm runs also watch each cell's own change (localFloor > 0; see the stop below).
   glm::vec3 localFloor(0.0f);
+  PropagationWarmStart* warm = options.warmStart;
   const auto iterate = [&](const glm::vec3& omega, float sourceWeight) {
     std::fill(sums.begin(), sums.end(), ChebyshevSums{});
     const bool local = localFloor != glm::vec3(0.0f);
@@ -494,10 +521,10 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
         for (int z = zs.begin(); z < zs.end(); ++z) {
           if (local)
             chebyshevSlice<kRetain, kConduct, true>(z, f, factors, current, older, source, omega, sourceWeight,
-                                                    localFloor, sums[z]);
+                                                    localFloor, warm->shell.data(), sums[z]);
           else
             chebyshevSlice<kRetain, kConduct, false>(z, f, factors, current, older, source, omega, sourceWeight,
-                                                     localFloor, sums[z]);
+                                                     localFloor, nullptr, sums[z]);
         }
       });
     });
@@ -516,7 +543,6 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   // A warm start needs a source: with none the cold path's probe finds the scene dark
   // and stops at once, where iterating the old light down to zero would take as long as
   // a cold run.
-  PropagationWarmStart* warm = options.warmStart;
   const bool lit = previous.x > 0.0 || previous.y > 0.0 || previous.z > 0.0;
   result.warmStarted = warm && warm->holds(f) && lit;
   // A radius of 0 (a channel that was dark) would make the stop rule's rate 0 and end the
@@ -524,6 +550,7 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
   for (int ch = 0; ch < 3 && result.warmStarted; ++ch)
     if (previous[ch] > 0.0 && !(warm->rho[ch] > 0.0)) result.warmStarted = false;
   if (result.warmStarted) {
+    if (warm->shell.size() != f.cellCount()) warm->shell = shadedShell(f, factors.active);
     std::size_t activeCells = 0;
     for (unsigned char a : factors.active) activeCells += a;
     for (int ch = 0; ch < 3; ++ch) {
