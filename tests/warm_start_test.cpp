@@ -242,6 +242,13 @@ TEST(WarmStart, ARenderersWarmFramesMatchAFreshRenderersColdOnes) {
   RenderReport full;
   renderer.render(scene.lpv, &full);
   EXPECT_FALSE(full.propagation.warmStarted);
+  // As does a frame after resetPropagation (frame_bench's full frames).
+  renderer.setLights(scene.lights);
+  renderer.resetPropagation();
+  RenderReport reset;
+  renderer.render(scene.lpv, &reset);
+  EXPECT_FALSE(reset.propagation.warmStarted);
+  EXPECT_EQ(reset.propagation.stepsRun, full.propagation.stepsRun) << "the same cold run as the last frame's";
 }
 
 }  // namespace
