@@ -3,7 +3,7 @@
 // setting at a time around a baseline (32³ grid, 8 steps, 256² shadow map, ~110K
 // triangles, 1 light, 512² image). Prints a table; not a test.
 //
-//   frame_bench [--repeats 7] [--warmup 2] [--backend both|cpu|vulkan] [--quick] [--no-big]
+//   frame_bench [--repeats 7] [--warmup 2] [--backend both|cpu|vulkan] [--quick] [--no-big] [--only SWEEP]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -36,6 +36,7 @@ struct Case {
 struct Options {
   int repeats = 7, warmup = 2;
   bool cpu = true, vulkan = true, quick = false, big = true;
+  std::string only;  ///< run only the cases of this sweep (empty: all)
 };
 
 double median(std::vector<double> v) {
@@ -70,12 +71,20 @@ Scene sceneFor(const Case& c, const std::shared_ptr<const TriangleMesh>& mesh) {
 struct Row {
   double voxelize = 0, resample = 0, shadow = 0, inject = 0, propagate = 0, shade = 0, total = 0, wall = 0;
   double cameraOnly = 0;
-  int steps = 0;
+  double nudge = 0;     ///< wall clock of a frame after a small light move (CPU: warm-started)
+  int steps = 0, nudgeSteps = 0;
   std::size_t activeCells = 0;
 };
 
-/// Full frames (lights marked changed: shadow maps onwards) and camera-only frames, each
-/// after `warmup` untimed ones; the first frame also gives the setup stages.
+/// A full frame starts its propagation cold; the GPU's always does.
+void startCold(CpuRenderer& renderer) { renderer.resetPropagation(); }
+void startCold(gpu::VulkanRenderer&) {}
+
+/// Full frames (lights marked changed: shadow maps onwards, propagation from scratch),
+/// camera-only frames and light-nudge frames (every light 0.5 units up or down, about
+/// 0.2 degrees as seen from the object, propagation from the last frame's light where the
+/// backend keeps it), each after `warmup` untimed ones; the first frame also gives the
+/// setup stages.
 template <typename Renderer>
 Row measure(Renderer& renderer, const Scene& scene, const Options& o) {
   Row row;
@@ -87,6 +96,7 @@ Row measure(Renderer& renderer, const Scene& scene, const Options& o) {
   std::vector<double> shadow, inject, propagate, shade, total, wall, camera;
   for (int i = 0; i < o.warmup + o.repeats; ++i) {
     renderer.setLights(scene.lights);
+    startCold(renderer);
     renderer.render(scene.lpv, &report);
     if (i < o.warmup) continue;
     shadow.push_back(report.times.shadowMap);
@@ -104,6 +114,17 @@ Row measure(Renderer& renderer, const Scene& scene, const Options& o) {
     renderer.render(scene.lpv, &report);
     if (i >= o.warmup) camera.push_back(report.wallMs);
   }
+  std::vector<double> nudge;
+  std::vector<Light> lights = scene.lights;
+  for (int i = 0; i < o.warmup + o.repeats; ++i) {
+    for (Light& l : lights) l.position.y += i % 2 ? -0.5 : 0.5;
+    renderer.setLights(lights);
+    renderer.render(scene.lpv, &report);
+    if (i < o.warmup) continue;
+    nudge.push_back(report.wallMs);
+    row.nudgeSteps = report.propagation.stepsRun;
+  }
+  row.nudge = median(nudge);
   row.shadow = median(shadow);
   row.inject = median(inject);
   row.propagate = median(propagate);
@@ -132,10 +153,11 @@ void printRow(const Case& c, const char* backend, const Row& r, const Roofline& 
     const double attainable = std::min(roof.peaks.fmaGflops, intensity * roof.peaks.bandwidth());
     std::snprintf(roofText, sizeof roofText, " | %7.2f %6.2f %5.1f", gflops, gbs, 100.0 * gflops / attainable);
   }
-  std::printf("%-9s %-7s %5d %5s %6d %9zu %2d | %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f | %9.2f %9.2f | %8.2f %7d %9zu%s\n",
+  std::printf("%-9s %-7s %5d %5s %6d %9zu %2d | %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %5d | %9.2f %9.2f | "
+              "%8.2f %7d %9zu%s\n",
               c.sweep.c_str(), backend, c.grid, c.steps ? std::to_string(c.steps).c_str() : "auto", c.shadowMap,
-              c.triangles, c.lights, r.shadow, r.inject, r.propagate, r.shade, r.total, r.wall, r.cameraOnly,
-              r.voxelize, r.resample, mcells, r.steps, r.activeCells, roofText);
+              c.triangles, c.lights, r.shadow, r.inject, r.propagate, r.shade, r.total, r.wall, r.cameraOnly, r.nudge,
+              r.nudgeSteps, r.voxelize, r.resample, mcells, r.steps, r.activeCells, roofText);
   std::fflush(stdout);
 }
 
@@ -157,6 +179,7 @@ int main(int argc, char** argv) {
       o.vulkan = b == "vulkan" || b == "both";
     } else if (a == "--quick") o.quick = true;
     else if (a == "--no-big") o.big = false;
+    else if (a == "--only") o.only = next();
     else {
       std::fprintf(stderr, "frame_bench: unknown argument %s\n", a.c_str());
       return 2;
@@ -192,6 +215,16 @@ int main(int argc, char** argv) {
     c.lights = 2;
     cases.push_back(c);
   }
+  for (int g : {32, 64}) {
+    Case c = base;
+    c.sweep = "auto";
+    c.grid = g;
+    c.steps = 0;
+    cases.push_back(c);
+  }
+  if (!o.only.empty())
+    cases.erase(std::remove_if(cases.begin(), cases.end(), [&](const Case& c) { return c.sweep != o.only; }),
+                cases.end());
   if (o.quick) cases.resize(std::min<std::size_t>(cases.size(), 4));
 
   std::unique_ptr<gpu::VulkanDevice> device;
@@ -205,7 +238,9 @@ int main(int argc, char** argv) {
   }
   std::printf("frame_bench: median of %d frames after %d warm-up; 512x512 image; times in ms\n", o.repeats, o.warmup);
   std::printf("stage columns are device times (GPU timestamps) for vulkan, wall clock per stage for cpu;\n"
-              "wall = whole frame as the caller sees it; camera = wall clock of a camera-only re-render;\n"
+              "wall = whole frame as the caller sees it (propagation from scratch); camera = wall clock of a\n"
+              "camera-only re-render; nudge, nsteps = wall clock and steps of a frame after a 0.5-unit light move\n"
+              "(cpu --steps auto: propagation from the last frame's light);\n"
               "voxelize/resample run once per mesh or material change (shown from the first frame)\n");
   Roofline roof;
   if (device) {
@@ -220,9 +255,11 @@ int main(int argc, char** argv) {
                 roof.peaks.fmaGflops, roof.peaks.bandwidth(), bench::kFlopsPerCellStep, bench::kBytesPerCellStep,
                 bench::kIsotropicFlopsPerCellStep);
   }
-  std::printf("%-9s %-7s %5s %5s %6s %9s %2s | %8s %8s %8s %8s %8s %8s %8s | %9s %9s | %8s %7s %9s | %7s %6s %5s\n", "sweep",
-              "backend", "grid", "steps", "shadow", "triangles", "L", "shadow", "inject", "propag", "shade", "total",
-              "wall", "camera", "voxelize", "resample", "Mcell/s", "steps", "active", "GFLOP/s", "GB/s", "roof%");
+  std::printf("%-9s %-7s %5s %5s %6s %9s %2s | %8s %8s %8s %8s %8s %8s %8s %8s %5s | %9s %9s | %8s %7s %9s | %7s %6s "
+              "%5s\n",
+              "sweep", "backend", "grid", "steps", "shadow", "triangles", "L", "shadow", "inject", "propag", "shade",
+              "total", "wall", "camera", "nudge", "nsteps", "voxelize", "resample", "Mcell/s", "steps", "active",
+              "GFLOP/s", "GB/s", "roof%");
 
   std::shared_ptr<const TriangleMesh> mesh;
   std::size_t meshTarget = 0;

@@ -58,7 +58,7 @@ struct Row {
   int grid = 0;
   bool autoSteps = false;
   Run med;
-  double full = 0, fullResample = 0, fullPropagation = 0, cold = 0;
+  double full = 0, fullResample = 0, fullPropagation = 0, fullSteps = 0, cold = 0;
   double maxDifference = 0;  ///< incremental vs full frame, largest over all runs
   std::size_t gridCells = 0;
 };
@@ -111,7 +111,7 @@ Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, boo
   std::unique_ptr<PreviewRenderer> full = makePreviewRenderer(fullScene, backend);
   full->setMaterialSet(session.engine().materialSet(), std::nullopt);
   full->render(session.previewSettings(), nullptr);
-  std::vector<double> fullMs, fullResample, fullPropagation;
+  std::vector<double> fullMs, fullResample, fullPropagation, fullSteps;
 
   std::vector<Run> samples;
   for (int i = 0; i < warmup + runs; ++i) {
@@ -156,6 +156,7 @@ Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, boo
     fullMs.push_back(fullWall);
     fullResample.push_back(fullFrame.times.resample);
     fullPropagation.push_back(fullFrame.times.propagation);
+    fullSteps.push_back(fullFrame.propagation.stepsRun);
   }
   Run& m = row.med;
   m.paint = medianOf(samples, [](const Run& r) { return r.paint; });
@@ -173,16 +174,17 @@ Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, boo
   row.full = median(fullMs);
   row.fullResample = median(fullResample);
   row.fullPropagation = median(fullPropagation);
+  row.fullSteps = median(fullSteps);
   return row;
 }
 
 void printRow(const Row& r) {
   std::printf(
       "%-18s %-7s %4d %5s %5.0f %4.0f %8.0f %7.0f/%-7zu | %8.2f | %8.2f %7.2f %8.2f %7.2f %6.2f | %8.2f | %8.2f "
-      "(%7.2f %8.2f) %8.2f | %6.3f %6.3f %8.1e\n",
+      "(%7.2f %8.2f %5.0f) %8.2f | %6.3f %6.3f %8.1e\n",
       r.scene.c_str(), r.backend.substr(0, r.backend.find(' ')).c_str(), r.grid, r.autoSteps ? "auto" : "8",
       r.med.steps, r.med.dabs, r.med.voxels, r.med.cells, r.gridCells, r.med.paint, r.med.preview, r.med.resample,
-      r.med.propagation, r.med.shading, r.med.other, r.med.total, r.full, r.fullResample, r.fullPropagation, r.cold,
+      r.med.propagation, r.med.shading, r.med.other, r.med.total, r.full, r.fullResample, r.fullPropagation, r.fullSteps, r.cold,
       r.med.preview / r.full, r.med.total / r.full, r.maxDifference);
 }
 
@@ -222,12 +224,14 @@ int main(int argc, char** argv) {
   std::printf("stroke: ~20 dabs, radius 3 LPV cells, smooth falloff, albedo_mfp set (alternating targets)\n");
   std::printf("paint = beginStroke..endStroke; preview = renderPreview (stages: resample, propagate, shade, other =\n"
               "voxelize+shadow+inject, should be 0); full = whole-material frame (resample all + propagate + shade);\n"
-              "cold = the session's first frame (everything, incl. one-time setup); inc/full = preview/full, "
+              "ran = the preview's propagation steps (cpu --steps auto: from the last frame's light), full steps =\n"
+              "the full frame's (from scratch); cold = the session's first frame (everything, incl. one-time\n"
+              "setup); inc/full = preview/full, "
               "tot/full = (paint+preview)/full;\n"
               "maxdiff = largest relative pixel difference, incremental preview vs the full frame (all runs)\n\n");
-  std::printf("%-18s %-7s %4s %5s %5s %4s %8s %15s | %8s | %8s %7s %8s %7s %6s | %8s | %8s (%7s %8s) %8s | %6s %6s %8s\n",
+  std::printf("%-18s %-7s %4s %5s %5s %4s %8s %15s | %8s | %8s %7s %8s %7s %6s | %8s | %8s (%7s %8s %5s) %8s | %6s %6s %8s\n",
               "scene", "backend", "grid", "steps", "ran", "dabs", "voxels", "cells resampled", "paint", "preview",
-              "resamp", "propag", "shade", "other", "total", "full", "resamp", "propag", "cold", "inc/f", "tot/f",
+              "resamp", "propag", "shade", "other", "total", "full", "resamp", "propag", "steps", "cold", "inc/f", "tot/f",
               "maxdiff");
 
   std::vector<PreviewBackendKind> kinds;

@@ -52,11 +52,17 @@ void CpuRenderer::setLights(const std::vector<Light>& lights) {
 void CpuRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) {
   object_.setMaterialSet(std::move(set));
   dirty_.materialChanged(touched);
+  if (!touched) warm_.clear();
 }
 
 Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
   Stopwatch frameWatch;
-  if (lastSettings_) dirty_.settingsChanged(*lastSettings_, settings);
+  if (lastSettings_) {
+    dirty_.settingsChanged(*lastSettings_, settings);
+    if (lastSettings_->resolution != settings.resolution || lastSettings_->scheme != settings.scheme ||
+        lastSettings_->steps != settings.steps || lastSettings_->autoSteps != settings.autoSteps)
+      warm_.clear();
+  }
   lastSettings_ = settings;
 
   RenderReport& report = last_;
@@ -132,6 +138,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     options.steps = settings.steps;
     options.autoSteps = settings.autoSteps;
     options.chebyshev = true;
+    options.warmStart = &warm_;
     report.propagation = propagate(material_, factors_, field, accumulated_, options);
     report.times.propagation = watch.lapMs();
   } else {

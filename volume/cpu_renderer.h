@@ -38,6 +38,10 @@ class CpuRenderer {
   /// `touched` (world bounds; everything when absent) and re-propagates.
   void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched);
 
+  /// The next propagation starts cold, as the first frame's does, instead of from the
+  /// last frame's converged light (benchmarks of whole frames, comparisons).
+  void resetPropagation() { warm_.clear(); }
+
   const Scene& scene() const { return scene_; }
 
  private:
@@ -54,6 +58,10 @@ class CpuRenderer {
   std::vector<SurfaceFluxSample> samples_;
   std::vector<EntryMap> entries_;  ///< the shadow maps' texels for the single-scattering term
   ShGrid injected_, accumulated_;
+  /// The last converged light, the start of the next propagation after a stroke or a light
+  /// change. Dropped where the problem is new: another grid, scheme or step setting, or
+  /// a whole new material set (so a full frame is a cold one).
+  PropagationWarmStart warm_;
   RenderReport last_;
   Image image_;
 };

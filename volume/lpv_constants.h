@@ -56,6 +56,12 @@
 #define SSLPV_CHEBYSHEV_STALL_WINDOW 64
 // Spectral radius estimates stay below 1 by this much (a ratio of 1 is float noise).
 #define SSLPV_CHEBYSHEV_MAX_RHO (1.0 - 1e-7)
+// A warm-started semi-iteration (PropagationWarmStart) stops only once the light still to
+// come in every cell the shading reads is under a tolerance of the cell's own light
+// (PropagationOptions::warmLocalTolerance); cells darker than this share of the mean
+// cell's light are held to it instead, so that float noise in the dark does not keep a
+// run going.
+#define SSLPV_WARM_START_LOCAL_FLOOR 1e-2
 
 // The calibrated exit law's table (volume/exit_law.h): rows over t = sqrt(1 - a') at
 // t = k / ALBEDO_INTERVALS, columns over the outside cosine mu_o = j / MU_INTERVALS,

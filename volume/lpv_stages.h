@@ -80,6 +80,31 @@ struct StepEnergy {
   glm::dvec3 clampRemoved{0.0};  ///< power the clamp would have created, removed this step
 };
 
+/// The converged light of a previous Chebyshev run (PropagationOptions::chebyshev), kept
+/// by a renderer between frames so that the next run starts from it instead of from the
+/// new source: after a stroke or a light nudge only what changed, and the light it moves,
+/// has to re-converge. Any start converges to the same x = (I - T)^-1 y (the iteration's
+/// error is a polynomial in T applied to the start's error, whatever T and y now are), and
+/// the stop rule bounds the light still to come relative to the whole light, so a warm
+/// result meets the same tolerance as a cold one.
+struct PropagationWarmStart {
+  GridFrame frame;                       ///< the grid `light` belongs to (dims, origin, cell)
+  std::array<std::vector<float>, 3> light;  ///< per channel, x (c0) over the frame's cells
+  /// Per channel, the spectral radius the run that produced `light` estimated. A warm run
+  /// reuses it instead of probing: an estimate off the new T's radius only converges more
+  /// slowly, and the stop rule then follows the shrink it observes.
+  glm::dvec3 rho{0.0};
+  /// Per cell of `frame`: an active cell within two cells of an inactive one, where the
+  /// shading reads the light (half a cell, at most one cell, inside the surface, trilinear).
+  /// Filled by the first warm run on the frame.
+  std::vector<unsigned char> shell;
+  bool holds(const GridFrame& f) const {
+    return !light[0].empty() && light[0].size() == f.cellCount() && frame.dims == f.dims &&
+           frame.origin == f.origin && frame.cellSize == f.cellSize;
+  }
+  void clear() { *this = PropagationWarmStart{}; }
+};
+
 struct PropagationOptions {
   int steps = 8;
   bool autoSteps = false;
@@ -107,6 +132,17 @@ struct PropagationOptions {
   /// for it; the default keeps the plain steps, whose per-step light the tests inspect.
   /// On the GPU, device-resident runs only (GpuPropagator::runOnDevice, record).
   bool chebyshev = false;
+  /// With chebyshev: where it holds a run on the same grid, start from its light (and
+  /// radius) instead of probing from the new source; either way it receives this run's
+  /// converged light. Null: every run starts cold.
+  PropagationWarmStart* warmStart = nullptr;
+  /// A warm start's error sits where the frame changed, where a share of the total that
+  /// the usual stop lets through can be most of a region's light. So a warm run stops
+  /// only once, besides that, the light still to come (its change, extrapolated as the
+  /// total's) in every cell the shading reads (PropagationWarmStart::shell) is under this
+  /// share of the cell's own light (for cells under SSLPV_WARM_START_LOCAL_FLOOR of the
+  /// mean cell's, of that floor). A cold run's worst cell is about as far off.
+  double warmLocalTolerance = 1e-2;
 };
 
 /// The Chebyshev semi-iteration's weight for iterate k + 1 (k ≥ 1; iterate 1 has weight
@@ -130,6 +166,8 @@ struct PropagationResult {
   /// Auto steps: the run reached maxAutoSteps before its stop rule held, so the light is
   /// not converged (reported by the CLI and in the timing table).
   bool capped = false;
+  /// The Chebyshev run started from a previous frame's light (PropagationWarmStart).
+  bool warmStarted = false;
 };
 
 /// Per-cell transport factors of one step, derived from the material grid. Seed scheme:

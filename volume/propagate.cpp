@@ -287,6 +287,8 @@ void gatherSliceIsotropic(int z, const StepFactors& factors, const ShGrid& src, 
 struct ChebyshevSums {
   glm::dvec3 change{0.0};  ///< Σ |x_{k+1} - x_k| over active cells (c0)
   glm::dvec3 total{0.0};   ///< Σ x_{k+1}
+  /// kLocal only: the largest |x_{k+1} - x_k| / max(|x_{k+1}|, floor) over active cells.
+  glm::dvec3 localChange{0.0};
 };
 
 /// One iterate of the Chebyshev semi-iteration for x = (I - T)^-1 y on the isotropic
@@ -297,10 +299,12 @@ struct ChebyshevSums {
 /// A probe step is ω = 1 with sourceWeight 0, as lpv_propagate.comp's.
 using ChannelPlanes = std::array<std::vector<float>, 3>;  ///< one c0 plane per channel
 
-template <bool kRetain, bool kConduct>
+/// kLocal: also the largest change relative to the cell's own light (or `floor`, where
+/// brighter) over the cells of `shell` (PropagationWarmStart::shell).
+template <bool kRetain, bool kConduct, bool kLocal>
 void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const ChannelPlanes& current,
                     ChannelPlanes& older, const ChannelPlanes& source, const glm::vec3& omega, float sourceWeight,
-                    ChebyshevSums& s) {
+                    const glm::vec3& floor, const unsigned char* shell, ChebyshevSums& s) {
   const std::size_t sy = std::size_t(f.dims.x), sz = std::size_t(f.dims.x) * f.dims.y;
   for (int y = 1; y < f.dims.y - 1; ++y) {
     if (!factors.rowActive[std::size_t(z) * f.dims.y + y]) continue;
@@ -314,9 +318,9 @@ void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const
       const unsigned char* __restrict active = factors.active.data();
       const float* __restrict retain = kRetain ? factors.retention[ch].data() : nullptr;
       const float* __restrict conduct = kConduct ? factors.conductance[ch].data() : nullptr;
-      const float w = omega[ch];
-      float change = 0.0f, total = 0.0f;
-#pragma omp simd reduction(+ : change, total)
+      const float w = omega[ch], lightFloor = floor[ch];
+      float change = 0.0f, total = 0.0f, local = 0.0f;
+#pragma omp simd reduction(+ : change, total) reduction(max : local)
       for (int k = 0; k < row; ++k) {
         const std::size_t i = rowStart + k;
         const float g = isotropicGather<kRetain, kConduct, false>(x, retain, conduct, i, sy, sz);
@@ -325,9 +329,12 @@ void chebyshevSlice(int z, const GridFrame& f, const StepFactors& factors, const
         out[i] = next;
         change += std::abs(next - x[i]);
         total += next;
+        if constexpr (kLocal)
+          local = std::max(local, (shell[i] ? std::abs(next - x[i]) : 0.0f) / std::max(std::abs(next), lightFloor));
       }
       s.change[ch] += double(change);
       s.total[ch] += double(total);
+      s.localChange[ch] = std::max(s.localChange[ch], double(local));
     }
   }
 }
@@ -458,6 +465,30 @@ struct StallWatch {
   }
 };
 
+/// PropagationWarmStart::shell: the active cells within two cells (along every axis) of
+/// an inactive one, by a separable dilation of the inactive cells.
+std::vector<unsigned char> shadedShell(const GridFrame& f, const std::vector<unsigned char>& active) {
+  std::vector<unsigned char> near(active.size());
+  for (std::size_t i = 0; i < near.size(); ++i) near[i] = !active[i];
+  const std::size_t strides[3] = {1, std::size_t(f.dims.x), std::size_t(f.dims.x) * f.dims.y};
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<unsigned char> dilated(near.size(), 0);
+    for (int z = 0; z < f.dims.z; ++z)
+      for (int y = 0; y < f.dims.y; ++y)
+        for (int x = 0; x < f.dims.x; ++x) {
+          const int c[3] = {x, y, z};
+          const std::size_t i = f.index(x, y, z);
+          for (int d = -2; d <= 2 && !dilated[i]; ++d) {
+            const int at = c[axis] + d;
+            if (at >= 0 && at < f.dims[axis]) dilated[i] = near[std::size_t(std::ptrdiff_t(i) + d * std::ptrdiff_t(strides[axis]))];
+          }
+        }
+    near.swap(dilated);
+  }
+  for (std::size_t i = 0; i < near.size(); ++i) near[i] = near[i] && active[i];
+  return near;
+}
+
 /// Runs the semi-iteration for x = (I - T)^-1 y, y the light of the first step (in
 /// `field`, which ends holding the last iterate), adding x - y to `accumulated`, which
 /// already holds y. T is similar to a symmetric operator (T = S W (K + R) W / 6: survival,
@@ -465,7 +496,8 @@ struct StallWatch {
 /// with the weights for any rho < 1 the error of each mode λ shrinks as
 /// T_k(λ / rho) / T_k(1 / rho), which goes to 0 for every |λ| < 1: a rho under the true
 /// radius only converges more slowly, so the probe's estimate from below is safe. The
-/// iterates start from the last probe step's light; any start converges.
+/// iterates start from the last probe step's light, or, warm, from a previous frame's
+/// converged light (options.warmStart); any start converges.
 void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated, const PropagationOptions& options,
                   int maxSteps, PropagationResult& result) {
   const GridFrame& f = field.frame;
@@ -476,14 +508,24 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
     older[ch].assign(source[ch].size(), 0.0f);  // x_{-1}: weight 1 cancels it
   }
   std::vector<ChebyshevSums> sums(f.dims.z);
+  // Warm runs also watch each cell's own change (localFloor > 0; see the stop below).
+  glm::vec3 localFloor(0.0f);
+  PropagationWarmStart* warm = options.warmStart;
   const auto iterate = [&](const glm::vec3& omega, float sourceWeight) {
     std::fill(sums.begin(), sums.end(), ChebyshevSums{});
+    const bool local = localFloor != glm::vec3(0.0f);
     tbb::parallel_for(tbb::blocked_range<int>(1, f.dims.z - 1), [&](const tbb::blocked_range<int>& zs) {
       FlushDenormals flush;
       withBoundaryVariant(factors, [&](auto retain, auto conduct) {
         constexpr bool kRetain = decltype(retain)::value, kConduct = decltype(conduct)::value;
-        for (int z = zs.begin(); z < zs.end(); ++z)
-          chebyshevSlice<kRetain, kConduct>(z, f, factors, current, older, source, omega, sourceWeight, sums[z]);
+        for (int z = zs.begin(); z < zs.end(); ++z) {
+          if (local)
+            chebyshevSlice<kRetain, kConduct, true>(z, f, factors, current, older, source, omega, sourceWeight,
+                                                    localFloor, warm->shell.data(), sums[z]);
+          else
+            chebyshevSlice<kRetain, kConduct, false>(z, f, factors, current, older, source, omega, sourceWeight,
+                                                     localFloor, nullptr, sums[z]);
+        }
       });
     });
     std::swap(current, older);
@@ -492,18 +534,43 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
     for (const ChebyshevSums& s : sums) {
       total.change += s.change;
       total.total += s.total;
+      total.localChange = glm::max(total.localChange, s.localChange);
     }
     return total;
   };
-  // Probe: plain steps from y, whose power ratio approaches the spectral radius of the
-  // modes that carry the light from below (an estimate under the radius is safe: the
-  // iteration still converges, more slowly).
   glm::dvec3 previous(0.0), rho(0.0);
   for (int ch = 0; ch < 3; ++ch) for (float v : source[ch]) previous[ch] += v;
+  // A warm start needs a source: with none the cold path's probe finds the scene dark
+  // and stops at once, where iterating the old light down to zero would take as long as
+  // a cold run.
+  const bool lit = previous.x > 0.0 || previous.y > 0.0 || previous.z > 0.0;
+  result.warmStarted = warm && warm->holds(f) && lit;
+  // A radius of 0 (a channel that was dark) would make the stop rule's rate 0 and end the
+  // run before the light has spread.
+  for (int ch = 0; ch < 3 && result.warmStarted; ++ch)
+    if (previous[ch] > 0.0 && !(warm->rho[ch] > 0.0)) result.warmStarted = false;
+  if (result.warmStarted) {
+    if (warm->shell.size() != f.cellCount()) warm->shell = shadedShell(f, factors.active);
+    std::size_t activeCells = 0;
+    for (unsigned char a : factors.active) activeCells += a;
+    for (int ch = 0; ch < 3; ++ch) {
+      current[ch] = warm->light[ch];
+      double light = 0.0;
+      for (float v : current[ch]) light += v;
+      // Cells under this share of the mean cell's light do not hold up the stop.
+      localFloor[ch] = float(std::max(SSLPV_WARM_START_LOCAL_FLOOR * light / double(std::max<std::size_t>(activeCells, 1)),
+                                      double(std::numeric_limits<float>::min())));
+    }
+    rho = warm->rho;
+  }
+  // Probe (cold start): plain steps from y, whose power ratio approaches the spectral
+  // radius of the modes that carry the light from below (an estimate under the radius is
+  // safe: the iteration still converges, more slowly).
   // Where no light is left (a dark scene, or one absorbed within the probe) the light is
   // already converged: stop after the probe step that finds it so, as the GPU does.
   bool dark = false;
-  for (int k = 0; k < SSLPV_CHEBYSHEV_PROBE_STEPS && result.stepsRun < maxSteps && !dark; ++k) {
+  for (int k = 0; !result.warmStarted && k < SSLPV_CHEBYSHEV_PROBE_STEPS && result.stepsRun < maxSteps && !dark;
+       ++k) {
     const ChebyshevSums t = iterate(glm::vec3(1.0f), 0.0f);
     dark = !(previous.x > 0.0) && !(previous.y > 0.0) && !(previous.z > 0.0);
     for (int ch = 0; ch < 3; ++ch)
@@ -528,12 +595,25 @@ void runChebyshev(const StepFactors& factors, ShGrid& field, ShGrid& accumulated
     }
     lastChange = total.change;
     const glm::bvec3 stalled = stall.update(total, options.autoTolerance);
-    if (k > SSLPV_CHEBYSHEV_RATE_WINDOW && chebyshevConverged(total, effective, options.autoTolerance, stalled)) {
+    // A cold start's error is spread over the whole light, so bounding its sum bounds every
+    // region's; a warm start's sits where the frame changed, so its stop also bounds each
+    // cell's (PropagationOptions::warmLocalTolerance).
+    glm::dvec3 localTail(0.0);
+    if (result.warmStarted)
+      for (int ch = 0; ch < 3; ++ch) localTail[ch] = total.localChange[ch] * effective[ch] / (1.0 - effective[ch]);
+    const bool localConverged = glm::all(glm::lessThan(localTail, glm::dvec3(options.warmLocalTolerance)) || stalled);
+    if (k > SSLPV_CHEBYSHEV_RATE_WINDOW && localConverged &&
+        chebyshevConverged(total, effective, options.autoTolerance, stalled)) {
       converged = true;
       break;
     }
   }
   result.capped = !converged;
+  if (warm) {
+    warm->frame = f;
+    warm->rho = rho;
+    for (int ch = 0; ch < 3; ++ch) warm->light[ch] = current[ch];
+  }
   for (int ch = 0; ch < 3; ++ch) {
     float* sum = accumulated.plane(ch, 0);
     for (std::size_t i = 0; i < current[ch].size(); ++i) sum[i] += current[ch][i] - source[ch][i];
