@@ -234,8 +234,19 @@ TEST(WarmStart, ARenderersWarmFramesMatchAFreshRenderersColdOnes) {
   Bounds everything;
   everything.extend(glm::dvec3(-1e6));
   everything.extend(glm::dvec3(1e6));
+  // The renderer starts strokes cold (see CpuRenderer::setMaterialSet): the same image as
+  // a fresh renderer's.
   renderer.setMaterialSet(painted, everything);
-  expectMatchesCold("stroke", painted);
+  {
+    RenderReport afterStroke, cold;
+    const Image strokeImage = renderer.render(scene.lpv, &afterStroke);
+    CpuRenderer fresh(scene);
+    fresh.setMaterialSet(painted, std::nullopt);
+    const Image coldImage = fresh.render(scene.lpv, &cold);
+    EXPECT_FALSE(afterStroke.propagation.warmStarted);
+    EXPECT_EQ(afterStroke.propagation.stepsRun, cold.propagation.stepsRun);
+    EXPECT_LT(relativeDifference(strokeImage, coldImage).max, 1e-5);
+  }
 
   // A whole new material set is a new problem: the next frame starts cold.
   renderer.setMaterialSet(painted, std::nullopt);
