@@ -47,7 +47,7 @@ double squaredDistanceToTriangle(const glm::dvec3& p, const glm::dvec3& a, const
 
 /// True when a dab of `radius` at `p` overlaps the object: `p` inside it or within
 /// `radius` of its surface.
-bool dabTouchesObject(const TriangleMesh& mesh, const glm::dvec3& p, double radius) {
+bool dabTouchesObject(const TriangleMesh& mesh, MeshInsideTest& inside, const glm::dvec3& p, double radius) {
   const double r2 = radius * radius;
   for (const glm::uvec3& t : mesh.triangles) {
     const glm::dvec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
@@ -56,7 +56,7 @@ bool dabTouchesObject(const TriangleMesh& mesh, const glm::dvec3& p, double radi
     if (glm::any(glm::lessThan(p, lo)) || glm::any(glm::greaterThan(p, hi))) continue;
     if (squaredDistanceToTriangle(p, a, b, c) <= r2) return true;
   }
-  return pointInsideMesh(mesh, p);
+  return inside(p);
 }
 
 std::string pointText(const glm::dvec3& p) {
@@ -69,9 +69,10 @@ void warnAboutStroke(const std::string& strokes, std::size_t index, const Stroke
                      const TriangleMesh* mesh) {
   const std::string key = strokes + ": " + indexPath("strokes", index);
   if (mesh) {
+    MeshInsideTest inside(*mesh);
     std::size_t clear = 0, first = 0;
     for (std::size_t i = 0; i < stroke.points.size(); ++i)
-      if (!dabTouchesObject(*mesh, stroke.points[i], stroke.brush.radius) && clear++ == 0) first = i;
+      if (!dabTouchesObject(*mesh, inside, stroke.points[i], stroke.brush.radius) && clear++ == 0) first = i;
     if (clear > 0)
       printWarning(key + ".points: " + std::to_string(clear) + " of " + std::to_string(stroke.points.size()) +
                    " points are farther than the brush radius (" + formatNumber(stroke.brush.radius) +
@@ -162,7 +163,7 @@ int runPaint(const PaintArgs& args) {
   writeAtomicallyTogether({{args.output, [&](const std::filesystem::path& temp) { saveMaterialSet(out, temp); }},
                            sceneTextOutput(args.scene, std::move(updated))});
   printWrote(args.output, detail, start);
-  printWrote(args.scene, "material.vdb now names " + std::filesystem::path(args.output).filename().string(), start);
+  printWrote(args.scene, "material.vdb now names " + scenePathValue(args.scene, args.output), start);
   return 0;
 }
 

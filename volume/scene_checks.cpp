@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <glm/geometric.hpp>
 
 #include "volume/error.h"
@@ -26,11 +27,15 @@ std::string millimetres(double mm) {
 
 }  // namespace
 
-bool pointInsideMesh(const TriangleMesh& worldMesh, const glm::dvec3& point) {
-  if (worldMesh.triangles.empty()) return false;
-  const Bounds bounds = worldMesh.bounds();
-  if (glm::any(glm::lessThan(point, bounds.min)) || glm::any(glm::greaterThan(point, bounds.max))) return false;
-  const RayScene rays(worldMesh);
+MeshInsideTest::MeshInsideTest(const TriangleMesh& worldMesh) : mesh_(worldMesh), bounds_(worldMesh.bounds()) {}
+
+MeshInsideTest::~MeshInsideTest() = default;
+
+bool MeshInsideTest::operator()(const glm::dvec3& point) {
+  if (mesh_.triangles.empty() || bounds_.empty() || glm::any(glm::lessThan(point, bounds_.min)) ||
+      glm::any(glm::greaterThan(point, bounds_.max)))
+    return false;
+  if (!rays_) rays_ = std::make_unique<RayScene>(mesh_);
   // Directions off every axis and diagonal, so a ray does not graze an edge of a box or
   // run along a face; three votes outvote one ray slipping through a crack between triangles.
   const glm::vec3 directions[] = {glm::normalize(glm::vec3(0.5773f, 0.6168f, 0.5350f)),
@@ -38,7 +43,7 @@ bool pointInsideMesh(const TriangleMesh& worldMesh, const glm::dvec3& point) {
                                   glm::normalize(glm::vec3(0.7133f, -0.6702f, -0.2051f))};
   int inside = 0;
   for (const glm::vec3& d : directions) {
-    const RayHit hit = rays.intersect(glm::vec3(point), d);
+    const RayHit hit = rays_->intersect(glm::vec3(point), d);
     if (hit.hit && glm::dot(hit.normal, d) > 0.0f) ++inside;
   }
   return inside >= 2;
@@ -47,18 +52,19 @@ bool pointInsideMesh(const TriangleMesh& worldMesh, const glm::dvec3& point) {
 std::vector<std::string> sceneWarnings(const Scene& scene, const TriangleMesh& worldMesh) {
   std::vector<std::string> warnings;
   const std::string file = scene.file.string();
-  if (pointInsideMesh(worldMesh, scene.camera.position))
+  const Bounds bounds = worldMesh.bounds();
+  MeshInsideTest inside(worldMesh);
+  if (inside(scene.camera.position))
     warnings.push_back(file + ": camera.position " + point(scene.camera.position) +
                        " is inside the object: the image shows its inside, usually black; move the camera out");
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& light = scene.lights[i];
     if (light.type == Light::Type::Directional) continue;
-    if (pointInsideMesh(worldMesh, light.position))
+    if (inside(light.position))
       warnings.push_back(file + ": " + indexPath("lights", i) + ".position " + point(light.position) +
                          " is inside the object: the renderers light its surface from outside only, so this "
                          "light adds nothing; move it out");
   }
-  const Bounds bounds = worldMesh.bounds();
   if (!bounds.empty()) {
     const glm::dvec3 extent = bounds.extent();
     const double longestMm = std::max({extent.x, extent.y, extent.z}) * scene.unitInMm;
