@@ -73,7 +73,7 @@ std::vector<std::string> sceneWarnings(const Scene& scene, const TriangleMesh& w
                          formatNumber(scene.transform.scale) + ", units \"" + scene.units +
                          "\"), outside the " + millimetres(kTypicalObjectMinMm) + " to " +
                          millimetres(kTypicalObjectMaxMm) +
-                         " of translucent objects; check transform.scale and units (materials are per unit)");
+                         " translucent objects span; check transform.scale and units (materials are per unit)");
   }
   return warnings;
 }
