@@ -60,7 +60,7 @@ class EventScript {
   }
   EventScript& ctrl(char letter) { return key(std::string(1, letter), letter - 'a' + 1, 2); }
   /// Types `text` into a prompt, one key per character (the window reads the key code).
-  EventScript& type(const std::string& text) {
+  EventScript& typePath(const std::string& text) {
     for (char c : text) key(std::isalnum(static_cast<unsigned char>(c)) ? std::string(1, c) : "Typed", c);
     return *this;
   }
@@ -309,7 +309,7 @@ TEST(EditorGui, ExportPromptStartsEmptySoTheTypedPathIsTheWholePath) {
   test::writeText(p.events, EventScript()
                                 .drag(200, 402, 280, 402, 4)
                                 .ctrl('e')
-                                .type(typed.string())
+                                .typePath(typed.string())
                                 .enter()
                                 .ctrl('e')
                                 .enter()
@@ -345,7 +345,7 @@ TEST(EditorGui, CtrlSAsksBeforeReplacingAHandMadeSetAndSaveAsKeepsIt) {
                                 .drag(200, 402, 280, 402, 4)
                                 .ctrl('s')
                                 .key("S", 19, 3)  // Ctrl+Shift+S
-                                .type(mine.string())
+                                .typePath(mine.string())
                                 .enter()
                                 .str());
   const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--exit"});
