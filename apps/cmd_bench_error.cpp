@@ -27,6 +27,7 @@
 #include "gpu/vk_check.h"
 #include "gpu/vulkan_renderer.h"
 #endif
+#include "apps/cli_output.h"
 #include "volume/atomic_file.h"
 #include "volume/bench_table.h"
 #include "volume/cpu_renderer.h"
@@ -148,18 +149,11 @@ Reference obtainReference(const std::string& sceneArg, const Scene& scene, const
   options.spp = spp;
   options.seed = seed;
   const auto start = Clock::now();
-  int lastPercent = -1;
-  options.progress = [&](std::size_t done, std::size_t total) {
-    const int percent = int(100.0 * double(done) / double(total));
-    if (percent == lastPercent) return;
-    lastPercent = percent;
-    const double elapsed = secondsSince(start);
-    const double eta = done > 0 ? elapsed * double(total - done) / double(done) : 0.0;
-    std::fprintf(stderr, "\rreference: %3d%%  %.1f s elapsed, ETA %s   ", percent, elapsed, duration(eta).c_str());
-    std::fflush(stderr);
-  };
+  // Redrawn in place only on a terminal: a log gets one summary line, not carriage returns.
+  ProgressLine progress("reference");
+  options.progress = [&](std::size_t done, std::size_t total) { progress.update(done, total); };
   ReferenceResult result = tracer.render(options);
-  std::fprintf(stderr, "\n");
+  progress.finish("traced " + std::to_string(spp) + " spp at " + imageSizeText(result.radiance));
   want.seconds = secondsSince(start);
   // The sidecar goes last: a run killed in between leaves an EXR without one, which the
   // next run re-renders instead of trusting.

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 
+#include "apps/cli_output.h"
 #include "volume/atomic_file.h"
 #include "volume/error.h"
 #include "volume/image_io.h"
@@ -95,6 +96,7 @@ CLI::App* addCompareCommand(CLI::App& app, CompareArgs& args) {
 }
 
 int runCompare(const CompareArgs& args) {
+  const auto start = CliClock::now();
   if (args.block < 1) throw InputError("--block: must be at least 1, got " + std::to_string(args.block));
   if (!args.json.empty()) requireWritableOutput(args.json);
   if (!args.ratioMap.empty()) {
@@ -164,9 +166,14 @@ int runCompare(const CompareArgs& args) {
       if (!out) throwWriteFailed(args.json, errno);
     });
   }
-  if (!args.ratioMap.empty())
-    writeImage(ratioMap(blockA, blockB, mask, metrics.relativeFloor, args.block), args.ratioMap);
+  Image map;
+  if (!args.ratioMap.empty()) {
+    map = ratioMap(blockA, blockB, mask, metrics.relativeFloor, args.block);
+    writeImage(map, args.ratioMap);
+  }
   printTable(args, a, metrics);
+  if (!args.json.empty()) printWrote(args.json, "compare metrics", start);
+  if (!args.ratioMap.empty()) printWrote(args.ratioMap, imageSizeText(map), start);
   return 0;
 }
 

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "apps/cli_output.h"
 #include "volume/atomic_file.h"
 #include "volume/error.h"
 #include "volume/pbrt_export.h"
@@ -25,6 +26,7 @@ CLI::App* addExportCommand(CLI::App& app, ExportArgs& args) {
 }
 
 int runExport(const ExportArgs& args) {
+  const auto start = CliClock::now();
   std::string ext = std::filesystem::path(args.pbrt).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   // A fixed extension keeps a slip of the fingers from replacing the scene JSON itself.
@@ -41,6 +43,10 @@ int runExport(const ExportArgs& args) {
     std::cerr << "sslpv: warning: " << args.pbrt << ": g varies from " << summary.gMin << " to " << summary.gMax
               << " inside the object; pbrt's rgbgrid medium takes one g, so the file uses the mean "
               << summary.gMean << std::endl;
+  printWrote(args.pbrt,
+             "rgbgrid " + std::to_string(summary.dims.x) + "x" + std::to_string(summary.dims.y) + "x" +
+                 std::to_string(summary.dims.z) + ", " + std::to_string(summary.triangles) + " triangles",
+             start);
   return 0;
 }
 

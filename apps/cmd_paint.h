@@ -17,12 +17,15 @@ struct PaintArgs {
   /// The colour form for strokes that name no material (editor/stroke_io.h): "R,G,B" or
   /// one number each; empty when not given. g is optional, the other two go together.
   std::string colour, scatterDistance, g;
+  bool updateScene = false;  ///< --update-scene: point the scene's material.vdb at the output
 };
 
 CLI::App* addPaintCommand(CLI::App& app, PaintArgs& args);
 
-/// Prints one line per stroke (dabs, voxels changed, world bounds) to stdout. Throws
-/// InputError (exit 2) naming the file and key path on bad input; no output is written then.
+/// Prints one line per stroke (dabs, voxels changed, world bounds) to stdout and a warning
+/// per stroke that paints what the object does not show. Throws InputError (exit 2) naming
+/// the file and key path on bad input, and when no stroke changed a voxel; no output is
+/// written then.
 int runPaint(const PaintArgs& args);
 
 }  // namespace sslpv

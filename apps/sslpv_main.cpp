@@ -21,6 +21,8 @@
 #include "apps/cmd_paint.h"
 #include "apps/cmd_export.h"
 #include "apps/cmd_edit.h"
+#include "apps/cmd_inspect.h"
+#include "apps/cli_output.h"
 #ifdef SSLPV_HAVE_VULKAN
 #include "gpu/device.h"
 #include "gpu/vk_check.h"
@@ -34,6 +36,7 @@
 #include "volume/material_set.h"
 #include "volume/reference_tracer.h"
 #include "volume/scene.h"
+#include "volume/scene_checks.h"
 #include "volume/strict_json.h"
 
 namespace {
@@ -82,8 +85,31 @@ void warnIfOpticallyThin(const sslpv::RenderReport& report, const std::string& s
   std::cerr << text;
 }
 
+/// --size WxH: the image size instead of camera.width x camera.height (the aspect, and
+/// with it the horizontal field of view, follows the new size).
+void applySizeFlag(const std::string& size, sslpv::Camera& camera) {
+  using namespace sslpv;
+  const std::string expected = "--size: expected WxH with whole numbers from 1 to " + std::to_string(kMaxImageSide) +
+                               " (e.g. 640x480), got '" + size + "'";
+  const std::size_t x = size.find_first_of("xX");
+  if (x == std::string::npos || x == 0 || x + 1 == size.size()) throw InputError(expected);
+  auto side = [&](const std::string& text) {
+    if (text.size() > 6 || text.find_first_not_of("0123456789") != std::string::npos) throw InputError(expected);
+    const int value = std::stoi(text);
+    if (value < 1 || value > kMaxImageSide) throw InputError(expected);
+    return value;
+  };
+  camera.width = side(size.substr(0, x));
+  camera.height = side(size.substr(x + 1));
+}
+
+/// The scene warnings every renderer shares (camera or light inside the object, scale).
+void warnAboutScene(const sslpv::Scene& scene) {
+  for (const std::string& warning : sslpv::sceneWarnings(scene)) sslpv::printWarning(warning);
+}
+
 struct RenderArgs {
-  std::string scene, output, backend = "vulkan", steps, scheme;
+  std::string scene, output, backend = "vulkan", steps, scheme, size;
   std::optional<int> grid, shadowMap;
   bool timings = false;
   float exposure = 1.0f;
@@ -91,6 +117,7 @@ struct RenderArgs {
 
 int runRender(const RenderArgs& args) {
   using namespace sslpv;
+  const auto start = CliClock::now();
   if (args.backend != "cpu" && args.backend != "vulkan")
     throw InputError("--backend: unknown backend '" + args.backend + "' (vulkan, cpu)");
   if (!isSupportedImageExtension(args.output))
@@ -101,8 +128,16 @@ int runRender(const RenderArgs& args) {
     throw InputError("--exposure: must be in [" + formatNumber(kMinExposure) + ", " + formatNumber(kMaxExposure) +
                      "], got " + formatNumber(args.exposure));
 
+  Camera sized;
+  if (!args.size.empty()) applySizeFlag(args.size, sized);
+
   Scene scene = loadScene(args.scene);
   const LpvSettings settings = applyLpvFlags(scene.lpv, {args.grid, args.steps, args.shadowMap, args.scheme});
+  if (!args.size.empty()) {
+    scene.camera.width = sized.width;
+    scene.camera.height = sized.height;
+  }
+  warnAboutScene(scene);
 
   RenderReport report;
   Image image;
@@ -127,8 +162,10 @@ int runRender(const RenderArgs& args) {
               << report.propagation.stepsRun << " steps before converging; the image may be off (fixed --steps N runs N)"
               << std::endl;
   requireFiniteImage(image, args.scene, args.backend);
+  warnIfBlack(image, args.scene);
   writeImage(image, args.output, args.exposure);
   if (args.timings) std::cout << formatTimings(report);
+  printWrote(args.output, imageSizeText(image), start);
   return 0;
 }
 
@@ -138,47 +175,51 @@ struct ReferenceArgs {
   std::uint64_t seed = 0;
   int threads = 0;
   int maxScatter = 0;
+  float exposure = 1.0f;
 };
 
 int runReference(const ReferenceArgs& args) {
   using namespace sslpv;
+  const auto start = CliClock::now();
   std::string ext = std::filesystem::path(args.output).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".exr" && ext != ".pfm")
-    throw InputError("-o: " + args.output + ": unsupported output format (use .exr or .pfm: linear radiance)");
+  if (ext != ".exr" && ext != ".pfm" && ext != ".png")
+    throw InputError("-o: " + args.output +
+                     ": unsupported output format (use .png tone-mapped, or .exr or .pfm: linear radiance)");
+  if (!(args.exposure >= kMinExposure && args.exposure <= kMaxExposure))
+    throw InputError("--exposure: must be in [" + formatNumber(kMinExposure) + ", " + formatNumber(kMaxExposure) +
+                     "], got " + formatNumber(args.exposure));
   if (args.spp < 1 || args.spp > 1000000)
     throw InputError("--spp: must be a whole number from 1 to 1000000, got " + std::to_string(args.spp));
   if (args.threads < 0 || args.threads > 4096)
     throw InputError("--threads: must be between 0 (all cores) and 4096, got " + std::to_string(args.threads));
   if (args.maxScatter < 0)
     throw InputError("--max-scatter: must be 0 (unlimited) or more, got " + std::to_string(args.maxScatter));
+  // The standard error stays linear radiance beside a PNG too: it is for measuring noise.
   std::filesystem::path errorFile(args.output);
-  errorFile.replace_extension(".stderr" + std::filesystem::path(args.output).extension().string());
+  errorFile.replace_extension(".stderr" + (ext == ".png" ? std::string(".exr")
+                                                         : std::filesystem::path(args.output).extension().string()));
   requireWritableOutput(args.output);
   requireWritableOutput(errorFile);
 
   const Scene scene = loadScene(args.scene);
+  warnAboutScene(scene);
   const ReferenceTracer tracer(scene);
   ReferenceOptions options;
   options.spp = args.spp;
   options.seed = args.seed;
   options.threads = args.threads;
   options.maxScatterEvents = args.maxScatter;
-  const auto start = std::chrono::steady_clock::now();
-  int lastPercent = -1;
-  options.progress = [&](std::size_t done, std::size_t total) {
-    const int percent = int(100.0 * double(done) / double(total));
-    if (percent == lastPercent) return;
-    lastPercent = percent;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double eta = done > 0 ? elapsed * double(total - done) / double(done) : 0.0;
-    std::fprintf(stderr, "\rreference: %3d%%  %.1f s elapsed, ETA %.1f s   ", percent, elapsed, eta);
-    std::fflush(stderr);
-  };
+  ProgressLine progress("reference");
+  options.progress = [&](std::size_t done, std::size_t total) { progress.update(done, total); };
   const ReferenceResult result = tracer.render(options);
-  std::fprintf(stderr, "\n");
+  progress.finish("traced " + std::to_string(args.spp) + " spp at " + imageSizeText(result.radiance));
+  warnIfBlack(result.radiance, args.scene);
   // Together: a full disk must not leave a new image beside the old one's error image.
-  writeAtomicallyTogether({imageOutput(result.radiance, args.output), imageOutput(result.standardError, errorFile)});
+  writeAtomicallyTogether({imageOutput(result.radiance, args.output, args.exposure),
+                           imageOutput(result.standardError, errorFile)});
+  printWrote(args.output, imageSizeText(result.radiance), start);
+  printWrote(errorFile.string(), "standard error per pixel, " + imageSizeText(result.standardError), start);
   return 0;
 }
 
@@ -187,12 +228,18 @@ int runReference(const ReferenceArgs& args) {
 int main(int argc, char** argv) {
   CLI::App app{"sslpv: author and preview translucent heterogeneous materials (SSLPV)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "sslpv " SSLPV_VERSION);
+
+  std::string helpTopic;
+  CLI::App* helpCmd = app.add_subcommand("help", "List the commands, or show one command's options");
+  helpCmd->add_option("command", helpTopic, "The command to describe");
 
   RenderArgs render;
   CLI::App* renderCmd = app.add_subcommand("render", "Render a scene with SSLPV");
   renderCmd->add_option("scene", render.scene, "Scene JSON file")->required();
   renderCmd->add_option("-o,--output", render.output, "Output image (.png tone-mapped, .pfm/.exr linear)")
       ->required();
+  renderCmd->add_option("--size", render.size, "Image size WxH, e.g. 640x480 (overrides camera.width/height)");
   renderCmd->add_option("--backend", render.backend, "vulkan (default: Mesa lavapipe or a real GPU) or cpu");
   renderCmd->add_option("--grid", render.grid, "LPV cells along the longest axis (overrides lpv.resolution)");
   renderCmd->add_option("--steps", render.steps, "Propagation steps, or 'auto' (overrides lpv.steps)");
@@ -210,9 +257,12 @@ int main(int argc, char** argv) {
   CLI::App* referenceCmd =
       app.add_subcommand("reference", "Render a ground-truth image with a volumetric path tracer");
   referenceCmd->add_option("scene", reference.scene, "Scene JSON file")->required();
-  referenceCmd->add_option("-o,--output", reference.output, "Output image (.exr or .pfm, linear radiance)")
+  referenceCmd->add_option("-o,--output", reference.output,
+                           "Output image (.png tone-mapped like render, .exr/.pfm linear); the standard error "
+                           "goes beside it as NAME.stderr.exr/.pfm")
       ->required();
   referenceCmd->add_option("--spp", reference.spp, "Samples per pixel")->required();
+  referenceCmd->add_option("--exposure", reference.exposure, "PNG only: multiply radiance before tone mapping");
   referenceCmd->add_option("--seed", reference.seed, "Random seed (same seed, same image)");
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
   referenceCmd->add_option("--max-scatter", reference.maxScatter,
@@ -247,6 +297,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
     return fail(kExitInput, std::string(e.what()) + " (see sslpv --help)");
   }
@@ -263,6 +315,22 @@ int main(int argc, char** argv) {
         for (const std::string& value : option->results()) activity += " " + value;
   }
 
+  if (*helpCmd) {
+    if (helpTopic.empty()) {
+      // app.help() would describe the selected subcommand, `help` itself.
+      std::cout << app.get_formatter()->make_help(&app, app.get_name(), CLI::AppFormatMode::Normal);
+      return 0;
+    }
+    for (const CLI::App* sub : std::as_const(app).get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->get_name() == helpTopic && sub != helpCmd) {
+        std::cout << sub->help(app.get_name());
+        // The editor parses its own options: its list comes from the editor itself.
+        if (sub == editCmd) std::cout << "The editor's options: sslpv edit --help\n";
+        return 0;
+      }
+    return fail(kExitInput, "help: unknown command '" + helpTopic + "' (see sslpv help)");
+  }
+
   try {
     if (*renderCmd) return runRender(render);
     if (*referenceCmd) return runReference(reference);
@@ -275,6 +343,7 @@ int main(int argc, char** argv) {
     if (*inspectCmd) {
       if (!sslpv::inspectVdbFile(inspectFile, std::cout))
         return fail(kExitInput, inspectFile + ": the material set has validation problems (listed above)");
+      sslpv::printMaterialSummary(inspectFile, std::cout);
       return 0;
     }
   } catch (const sslpv::InputError& e) {

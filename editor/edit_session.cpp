@@ -13,6 +13,8 @@
 #include "volume/atomic_file.h"
 #include "volume/error.h"
 #include "volume/material_set.h"
+#include "volume/scene_file_edit.h"
+#include "volume/strict_json.h"
 
 namespace sslpv {
 namespace fs = std::filesystem;
@@ -20,6 +22,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kCreator = "sslpv edit";
+/// Sets these tools write are painted output: saving over one needs no confirmation.
+constexpr const char* kPaintedCreators[] = {kCreator, "sslpv paint"};
 constexpr int kMinPreviewSide = 16;
 
 fs::path recoveryPathFor(const fs::path& sceneFile) {
@@ -37,12 +41,18 @@ std::string readFile(const fs::path& file) {
   return text.str();
 }
 
-void writeFile(const fs::path& file, const std::string& text, const fs::path& target) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(target.string() + ": cannot write the file");
-  out << text;
-  out.flush();
-  if (!out) throwWriteFailed(target, errno);
+/// Whether two cameras frame the same view (the window's camera round-trips through
+/// VTK's doubles, so equal means equal to 1e-9 of the values).
+bool sameView(const Camera& a, const Camera& b) {
+  auto near = [](const glm::dvec3& x, const glm::dvec3& y) {
+    return glm::length(x - y) <= 1e-9 * std::max({1.0, glm::length(x), glm::length(y)});
+  };
+  return near(a.position, b.position) && near(a.target, b.target) &&
+         near(glm::normalize(a.up), glm::normalize(b.up)) && std::abs(a.fovYDeg - b.fovYDeg) <= 1e-9 * b.fovYDeg;
+}
+
+std::string jsonVec3(const glm::dvec3& v) {
+  return "[" + formatNumber(v.x) + ", " + formatNumber(v.y) + ", " + formatNumber(v.z) + "]";
 }
 
 bool hasVdbExtension(const fs::path& file) {
@@ -189,6 +199,17 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
   }
 
   PaintTarget target = makePaintTarget(m.scene);
+  // A set some other tool wrote (an example's hand-made set) is not replaced without the
+  // user's word, nor is an existing file the scene does not name.
+  std::error_code ignored;
+  if (m.scene.material.vdb) {
+    const std::string& creator = target.set->creator;
+    m.paths.saveNeedsConfirmation =
+        std::none_of(std::begin(kPaintedCreators), std::end(kPaintedCreators),
+                     [&](const char* painted) { return creator == painted; });
+  } else {
+    m.paths.saveNeedsConfirmation = fs::exists(m.paths.saveTarget, ignored);
+  }
   m.targetTemplate = target;
   m.targetTemplate.set.reset();
   m.engine = std::make_unique<BrushEngine>(std::move(target));
@@ -318,54 +339,65 @@ Image EditSession::renderPreview(RenderReport* report) {
 std::string EditSession::previewBackendName() const { return impl_->renderer->name(); }
 const LpvSettings& EditSession::previewSettings() const { return impl_->settings; }
 
-void EditSession::save() {
+void EditSession::save(bool replaceConfirmed) {
+  Impl& m = *impl_;
+  if (m.paths.saveNeedsConfirmation && !replaceConfirmed)
+    throw SaveNeedsConfirmation(m.paths.saveTarget.string() +
+                                ": not written by sslpv's painting tools (it may be a hand-made material set): "
+                                "confirm to replace it, or save as another file");
+  writeSaved(m.paths.saveTarget, m.paths.saveUpdatesScene);
+}
+
+void EditSession::saveAs(const fs::path& vdbFile, bool replaceConfirmed) {
+  if (!hasVdbExtension(vdbFile)) throw InputError(vdbFile.string() + ": the material set must be a .vdb file");
+  const fs::path target = vdbFile.lexically_normal();
+  std::error_code ignored;
+  const bool same = impl_->scene.material.vdb && fs::equivalent(target, *impl_->scene.material.vdb, ignored);
+  if (same) return save(replaceConfirmed);
+  if (fs::exists(target, ignored) && !replaceConfirmed)
+    throw SaveNeedsConfirmation(target.string() + ": the file exists: confirm to replace it");
+  writeSaved(target, /*nameInScene=*/true);
+}
+
+bool EditSession::cameraUnsaved() const { return !sameView(impl_->camera, impl_->scene.camera); }
+
+void EditSession::writeSaved(const fs::path& target, bool nameInScene) {
   Impl& m = *impl_;
   // Mid-stroke the voxels match no history position, so "saved" could not be recorded.
   m.requireNoStroke("save");
   const MaterialSet out = forWriting(*m.engine->materialSet());
-  const fs::path& target = m.paths.saveTarget;
-  if (!m.paths.saveUpdatesScene) {
+  const bool camera = cameraUnsaved();
+  if (!nameInScene && !camera) {
     saveMaterialSet(out, target);
   } else {
     const fs::path& sceneFile = m.paths.scene;
     requireWritableOutput(target);
     requireWritableOutput(sceneFile);
     const std::string original = readFile(sceneFile);
-    nlohmann::ordered_json doc;
-    try {
-      doc = nlohmann::ordered_json::parse(original);
-    } catch (const nlohmann::json::exception& e) {
-      throw InputError(sceneFile.string() + ": cannot rewrite the scene, it no longer parses: " + e.what());
+    // Only the values that change are replaced in the text: the author's layout, number
+    // spelling and key order stay (a generic JSON writer turned 15 lines into 90).
+    std::string text = nameInScene ? sceneTextNamingVdb(sceneFile, original, target) : original;
+    if (camera) {
+      const Camera& c = m.camera;
+      text = spliceJsonValue(text, {"camera", "position"}, jsonVec3(c.position), sceneFile);
+      text = spliceJsonValue(text, {"camera", "target"}, jsonVec3(c.target), sceneFile);
+      Camera upOnly = m.scene.camera;
+      upOnly.up = c.up;
+      if (!sameView(upOnly, m.scene.camera))
+        text = spliceJsonValue(text, {"camera", "up"}, jsonVec3(glm::normalize(c.up)), sceneFile);
+      text = spliceJsonValue(text, {"camera", "fov_y_deg"}, formatNumber(c.fovYDeg), sceneFile);
     }
-    if (!doc.is_object() || !doc.contains("material") || !doc["material"].is_object())
-      throw InputError(sceneFile.string() + ": cannot rewrite the scene: 'material' is not an object");
-    doc["material"]["vdb"] = target.filename().string();
-    const std::string rewritten = doc.dump(2) + "\n";
     // Refuse to write a scene the loader would reject (the file may have changed on disk).
-    parseScene(rewritten, sceneFile);
-
-    // The material goes to a temporary sibling, the scene is replaced, then the material
-    // is renamed into place: a failure at any step leaves both previous files.
-    bool sceneWritten = false;
-    try {
-      writeAtomically(target, [&](const fs::path& temp) {
-        saveMaterialSet(out, temp);
-        writeAtomically(sceneFile, [&](const fs::path& sceneTemp) { writeFile(sceneTemp, rewritten, sceneFile); });
-        sceneWritten = true;
-      });
-    } catch (...) {
-      if (sceneWritten) {
-        // The material was not renamed into place: the scene must not name it.
-        try {
-          writeAtomically(sceneFile, [&](const fs::path& sceneTemp) { writeFile(sceneTemp, original, sceneFile); });
-        } catch (...) {
-        }
-      }
-      throw;
-    }
-    m.scene.material.vdb = target;
+    const Scene written = parseScene(text, sceneFile);
+    // Every temporary is written before either file is replaced: a failure leaves both.
+    writeAtomicallyTogether({{target, [&](const fs::path& temp) { saveMaterialSet(out, temp); }},
+                             sceneTextOutput(sceneFile, text)});
+    m.scene.material.vdb = written.material.vdb;
+    m.scene.camera = written.camera;
     m.paths.saveUpdatesScene = false;
   }
+  m.paths.saveTarget = target;
+  m.paths.saveNeedsConfirmation = false;  // from now on the file holds this session's work
   m.savedId = m.topId();
   // The saved file now holds everything the recovery file did.
   std::error_code ignored;

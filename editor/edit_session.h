@@ -4,10 +4,15 @@
 // the window (editor/ui/) drives it, tests and benchmarks drive it headless.
 //
 // Files. Save writes the painted set to the scene's material.vdb. A scene without one
-// gets <scene dir>/<scene stem>_material.vdb, and Save then also rewrites the scene JSON
-// so that material.vdb names it (keys and values kept, key order kept). Every write is
-// atomic (temporary file + rename): a failed save leaves the previous file and the
-// in-memory state (painted voxels, history, unsaved flag) exactly as they were.
+// gets <scene dir>/<scene stem>_material.vdb, and Save then also updates the scene JSON
+// so that material.vdb names it. Save As writes to a file the user names and points
+// material.vdb there. A save also records the view when the camera moved (camera.position,
+// target, up, fov_y_deg). Scene updates replace those values in the text and leave every
+// other byte as it was. Save does not replace, without confirmation, a set that sslpv's
+// painting tools did not write (an example's hand-made set) or an existing file the scene
+// does not name. Every write is atomic (temporary file + rename): a failed save leaves
+// the previous files and the in-memory state (painted voxels, history, unsaved flag)
+// exactly as they were.
 //
 // Recovery. While there are unsaved changes the window calls autosave() a few seconds
 // after the last change; it writes the current set to <scene file>.recovery.vdb (same
@@ -25,6 +30,7 @@
 
 #include "editor/brush_engine.h"
 #include "volume/frame_report.h"
+#include "volume/error.h"
 #include "volume/image_io.h"
 #include "volume/scene.h"
 
@@ -60,7 +66,18 @@ struct SessionPaths {
   std::filesystem::path scene;       ///< the scene JSON
   std::filesystem::path saveTarget;  ///< where save() writes the material set
   bool saveUpdatesScene = false;     ///< the scene had no material.vdb: save() also rewrites the scene JSON
+  /// save() needs the user's confirmation: saveTarget holds work not from this session or
+  /// sslpv's painting tools (creator other than "sslpv edit"/"sslpv paint"), or exists
+  /// while the scene does not name it.
+  bool saveNeedsConfirmation = false;
   std::filesystem::path recovery;    ///< <scene file>.recovery.vdb
+};
+
+/// save()/saveAs() would replace a file the user has not agreed to replace; nothing was
+/// written. The window asks and calls again with the confirmation.
+class SaveNeedsConfirmation : public InputError {
+ public:
+  using InputError::InputError;
 };
 
 /// The recovery file <scene file>.recovery.vdb when it exists.
@@ -112,7 +129,14 @@ class EditSession {
 
   // Files. Throw InputError/ResourceError with a one-line reason; on failure nothing in
   // memory changes and the previous files stay intact.
-  void save();
+  /// Throws SaveNeedsConfirmation when paths().saveNeedsConfirmation and not `replaceConfirmed`.
+  void save(bool replaceConfirmed = false);
+  /// Writes the set to `vdbFile` (.vdb) and makes it the scene's material.vdb (the scene
+  /// file changes in that value only) and the target of later saves. An existing file
+  /// needs `replaceConfirmed` (SaveNeedsConfirmation otherwise).
+  void saveAs(const std::filesystem::path& vdbFile, bool replaceConfirmed = false);
+  /// The preview camera differs from the scene file's: the next save records it.
+  bool cameraUnsaved() const;
   /// Writes the current set to `vdbFile` (must end in .vdb); the saved state is unchanged.
   void exportMaterialSet(const std::filesystem::path& vdbFile) const;
   /// Writes the recovery file (atomically). Records changeCount() as autosaved.
@@ -126,6 +150,7 @@ class EditSession {
   void discardRecovery();
 
  private:
+  void writeSaved(const std::filesystem::path& target, bool nameInScene);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

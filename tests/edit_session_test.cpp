@@ -98,6 +98,18 @@ Image freshRender(const fs::path& sceneFile, const EditSession& session) {
   return renderer.render(session.previewSettings());
 }
 
+/// A set made by another tool, as the examples' (creator "sslpv make_examples").
+void saveHandMade(MaterialSet set, const fs::path& file) {
+  set.creator = "sslpv make_examples";
+  saveMaterialSet(set, file);
+}
+
+/// A set as an earlier editor session saved it: painted output, replaced without asking.
+void saveAsPaintedOutput(MaterialSet set, const fs::path& file) {
+  set.creator = "sslpv edit";
+  saveMaterialSet(set, file);
+}
+
 struct Files {
   TempDir dir;
   fs::path scene = dir / "scene.json";
@@ -198,7 +210,7 @@ TEST(EditSession, SaveWithVdbReplacesThatFileAndLeavesTheSceneAlone) {
   TempDir dir;
   fs::create_directory(dir / "mat");
   auto initial = makeEmptyMaterialSet(MaterialSample{{1.0f, 1.2f, 1.4f}, {0.9f, 1.0f, 1.1f}, 0.1f}, 0.1, "mm");
-  saveMaterialSet(*initial, dir / "mat" / "painted.vdb");
+  saveAsPaintedOutput(*initial, dir / "mat" / "painted.vdb");
   ordered json = sceneJson();
   json["material"]["vdb"] = "mat/painted.vdb";
   writeText(dir / "scene.json", json.dump(2));
@@ -248,7 +260,7 @@ TEST(EditSession, SaveIntoReadOnlyDirectoryFailsAndChangesNothing) {
   fs::create_directory(dir / "mat");
   ordered json = sceneJson();
   json["material"]["vdb"] = "mat/painted.vdb";
-  saveMaterialSet(*makeEmptyMaterialSet(MaterialSample{}, 0.1, "mm"), dir / "mat" / "painted.vdb");
+  saveAsPaintedOutput(*makeEmptyMaterialSet(MaterialSample{}, 0.1, "mm"), dir / "mat" / "painted.vdb");
   writeText(dir / "scene.json", json.dump(2));
   EditSession s(dir / "scene.json", smallPreview());
   s.applyStroke(darkStroke());
@@ -297,7 +309,7 @@ TEST(EditSession, SaveFailsWhenTheFileCannotBeWritten) {
   TempDir dir;
   ordered json = sceneJson();
   json["material"]["vdb"] = "painted.vdb";
-  saveMaterialSet(*makeEmptyMaterialSet(MaterialSample{}, 0.1, "mm"), dir / "painted.vdb");
+  saveAsPaintedOutput(*makeEmptyMaterialSet(MaterialSample{}, 0.1, "mm"), dir / "painted.vdb");
   writeText(dir / "with.json", json.dump(2));
   writeText(dir / "without.json", sceneJson().dump(2));
 
@@ -322,6 +334,93 @@ TEST(EditSession, SaveFailsWhenTheFileCannotBeWritten) {
   EXPECT_FALSE(with.unsaved());
   EXPECT_FALSE(without.unsaved());
   EXPECT_TRUE(sameVoxels(*loadMaterialSet(dir / "painted.vdb"), *with.engine().materialSet()));
+}
+
+// A hand-formatted scene naming a hand-made set.
+const std::string kHandScene =
+    "{\n"
+    "  \"units\": \"mm\",\n"
+    "  \"mesh\": {\"primitive\": \"box\", \"min\": [-5, -5, -5], \"max\": [5, 5, 5]},\n"
+    "  \"camera\": {\"position\": [6, 8, 30], \"target\": [0, 0, 0], \"fov_y_deg\": 35,\n"
+    "             \"width\": 64, \"height\": 48},\n"
+    "  \"material\": {\"base\": {\"sigma_t\": [1.0, 1.2, 1.4], \"sigma_s\": [0.9, 1.0, 1.1], \"g\": 0.1},\n"
+    "               \"vdb\": \"hand.vdb\", \"ior\": 1.3},\n"
+    "  \"lights\": [{\"type\": \"point\", \"position\": [10, 15, 30], \"intensity\": 2000}],\n"
+    "  \"lpv\": {\"resolution\": 16, \"steps\": 8, \"shadow_map\": 128}\n"
+    "}\n";
+
+std::string replacedOnce(const std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.substr(0, at) + to + text.substr(at + from.size());
+}
+
+TEST(EditSession, SaveOverAHandMadeSetNeedsConfirmationAndWritesNothingUntilThen) {
+  // Ctrl+S on an example replaced its hand-made set in place: now save() refuses with
+  // SaveNeedsConfirmation (both files byte-identical, still unsaved) until confirmed.
+  TempDir dir;
+  saveHandMade(*makeEmptyMaterialSet(MaterialSample{}, 0.1, "mm"), dir / "hand.vdb");
+  writeText(dir / "scene.json", kHandScene);
+  const std::string handBytes = readText(dir / "hand.vdb");
+  EditSession s(dir / "scene.json", smallPreview());
+  EXPECT_TRUE(s.paths().saveNeedsConfirmation);
+  ASSERT_GT(s.applyStroke(darkStroke()).voxelsChanged, 0u);
+  EXPECT_THROW(s.save(), SaveNeedsConfirmation);
+  EXPECT_EQ(readText(dir / "hand.vdb"), handBytes);
+  EXPECT_EQ(readText(dir / "scene.json"), kHandScene);
+  EXPECT_TRUE(s.unsaved());
+  s.save(/*replaceConfirmed=*/true);
+  EXPECT_FALSE(s.unsaved());
+  EXPECT_TRUE(sameVoxels(*loadMaterialSet(dir / "hand.vdb"), *s.engine().materialSet()));
+  EXPECT_FALSE(s.paths().saveNeedsConfirmation) << "the file now holds this session's work";
+  EXPECT_EQ(readText(dir / "scene.json"), kHandScene);
+}
+
+TEST(EditSession, SaveAsWritesTheNamedSetAndChangesOnlyMaterialVdbInTheScene) {
+  TempDir dir;
+  saveHandMade(*makeEmptyMaterialSet(MaterialSample{}, 0.1, "mm"), dir / "hand.vdb");
+  writeText(dir / "scene.json", kHandScene);
+  const std::string handBytes = readText(dir / "hand.vdb");
+  EditSession s(dir / "scene.json", smallPreview());
+  ASSERT_GT(s.applyStroke(darkStroke()).voxelsChanged, 0u);
+  EXPECT_THROW(s.saveAs(dir / "mine.png"), InputError);
+  s.saveAs(dir / "mine.vdb");
+  EXPECT_FALSE(s.unsaved());
+  EXPECT_EQ(readText(dir / "hand.vdb"), handBytes) << "the hand-made set is untouched";
+  EXPECT_EQ(readText(dir / "scene.json"), replacedOnce(kHandScene, "\"hand.vdb\"", "\"mine.vdb\""))
+      << "every other byte of the scene kept";
+  EXPECT_TRUE(sameVoxels(*loadMaterialSet(dir / "mine.vdb"), *s.engine().materialSet()));
+  EXPECT_EQ(s.paths().saveTarget, dir / "mine.vdb");
+  // Later saves go to the new file without asking; Save As onto an existing file asks.
+  s.applyStroke(darkStroke(1.0));
+  s.save();
+  EXPECT_FALSE(s.unsaved());
+  EXPECT_THROW(s.saveAs(dir / "hand.vdb"), SaveNeedsConfirmation);
+  EXPECT_EQ(readText(dir / "hand.vdb"), handBytes);
+}
+
+TEST(EditSession, SaveRecordsAMovedCameraInPlaceOfTheOldValues) {
+  // The camera was not saved; now a save writes the preview's view (not its size) into
+  // camera.position/target/fov_y_deg (and up where it changed), every other byte kept.
+  TempDir dir;
+  saveAsPaintedOutput(*makeEmptyMaterialSet(MaterialSample{}, 0.1, "mm"), dir / "hand.vdb");
+  writeText(dir / "scene.json", kHandScene);
+  EditSession s(dir / "scene.json", smallPreview());
+  EXPECT_FALSE(s.cameraUnsaved());
+  Camera moved = s.previewCamera();
+  moved.position = glm::dvec3(-12.5, 4, 20);
+  moved.target = glm::dvec3(0, 1, 0);
+  moved.fovYDeg = 28;
+  s.setPreviewCamera(moved);
+  EXPECT_TRUE(s.cameraUnsaved());
+  s.save();
+  std::string expected = replacedOnce(kHandScene, "[6, 8, 30]", "[-12.5, 4, 20]");
+  expected = replacedOnce(expected, "\"target\": [0, 0, 0]", "\"target\": [0, 1, 0]");
+  expected = replacedOnce(expected, "\"fov_y_deg\": 35", "\"fov_y_deg\": 28");
+  EXPECT_EQ(readText(dir / "scene.json"), expected);
+  EXPECT_FALSE(s.cameraUnsaved());
+  const Scene reloaded = loadScene(dir / "scene.json");
+  EXPECT_EQ(reloaded.camera.width, 64) << "the scene's image size is not the preview's";
 }
 
 TEST(EditSession, ExportNeedsVdbExtensionAndKeepsTheSavedState) {

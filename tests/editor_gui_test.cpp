@@ -7,6 +7,8 @@
 // three slice views x 0..320, 320..640, 640..960 at y 30..204 (slices across x, y, z).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "editor/brush_engine.h"
 #include "test_support.h"
 #include "volume/adding_doubling.h"
 #include "volume/image_io.h"
@@ -67,6 +70,12 @@ class EventScript {
     return key("Return", 13);
   }
   EventScript& click(int x, int y) { return drag(x, y, x, y, 0); }
+  /// Types `text` into a prompt, one key per character (the window reads the key code).
+  EventScript& typePath(const std::string& text) {
+    for (char c : text) key(std::isalnum(static_cast<unsigned char>(c)) ? std::string(1, c) : "Typed", c);
+    return *this;
+  }
+  EventScript& enter() { return key("Return", 13); }
   EventScript& wheelForward(int x, int y, int times) {
     for (int i = 0; i < times; ++i) event("MouseWheelForwardEvent", x, y);
     return *this;
@@ -369,6 +378,76 @@ TEST(EditorGui, HelpOverlayAndPreviewFollowingTheCamera) {
   // Preview: x 480..960, rows 20..396 (below its label line).
   EXPECT_GT(changedFraction(a, c, 480, 20, 960, 396), 0.02) << "the preview did not follow the camera";
   EXPECT_FALSE(fs::exists(p.recovery)) << "nothing was painted, so there is nothing to recover";
+}
+
+std::vector<std::string> dirNames(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(EditorGui, ExportPromptStartsEmptySoTheTypedPathIsTheWholePath) {
+  // The prompt was prefilled with cube_export.vdb and typing appended to it
+  // ("cube_export.vdb/tmp/x.vdb"). Now it starts empty: the typed path is written as
+  // typed; Enter on an empty prompt writes the suggestion.
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  Project p;
+  const fs::path typed = p.dir / "typed.vdb";
+  test::writeText(p.events, EventScript()
+                                .drag(200, 402, 280, 402, 4)
+                                .ctrl('e')
+                                .typePath(typed.string())
+                                .enter()
+                                .ctrl('e')
+                                .enter()
+                                .str());
+  const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--exit"});
+  ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  ASSERT_TRUE(fs::exists(typed)) << r.stderrText;
+  EXPECT_GT(activeVoxels(typed), 0u);
+  EXPECT_TRUE(fs::exists(p.dir / "cube_export.vdb")) << "Enter on the empty prompt writes the suggestion";
+  std::vector<std::string> names = dirNames(p.dir.path());
+  names.erase(std::remove(names.begin(), names.end(), p.recovery.filename().string()), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"cube.json", "cube_export.vdb", "events.txt", "typed.vdb"}))
+      << "an export is not a save; nothing else is written";
+}
+
+TEST(EditorGui, CtrlSAsksBeforeReplacingAHandMadeSetAndSaveAsKeepsIt) {
+  // The scene names a set sslpv's painting tools did not write: Ctrl+S writes nothing and
+  // says why; Ctrl+Shift+S with a typed path writes there and the scene's material.vdb
+  // (only that value) names the new file.
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  Project p;
+  // Made by another tool, as the examples' sets are.
+  MaterialSet hand = *makeEmptyMaterialSet(MaterialSample{{1.0f, 1.2f, 1.4f}, {0.9f, 1.0f, 1.1f}, 0.0f}, 0.1, "mm");
+  hand.creator = "sslpv make_examples";
+  saveMaterialSet(hand, p.dir / "hand.vdb");
+  nlohmann::ordered_json scene = nlohmann::ordered_json::parse(kScene);
+  scene["material"]["vdb"] = "hand.vdb";
+  const std::string sceneText = scene.dump(2);
+  test::writeText(p.scene, sceneText);
+  const std::string handBytes = test::readText(p.dir / "hand.vdb");
+  const fs::path mine = p.dir / "mine.vdb";
+  test::writeText(p.events, EventScript()
+                                .drag(200, 402, 280, 402, 4)
+                                .ctrl('s')
+                                .key("S", 19, 3)  // Ctrl+Shift+S
+                                .typePath(mine.string())
+                                .enter()
+                                .str());
+  const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--exit"});
+  ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  EXPECT_NE(r.stderrText.find("hand.vdb: not written by sslpv's painting tools"), std::string::npos) << r.stderrText;
+  EXPECT_EQ(test::readText(p.dir / "hand.vdb"), handBytes) << "the hand-made set was replaced";
+  ASSERT_TRUE(fs::exists(mine)) << r.stderrText;
+  EXPECT_GT(activeVoxels(mine), 0u);
+  const std::string after = test::readText(p.scene);
+  const std::size_t at = sceneText.find("\"hand.vdb\"");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_EQ(after, sceneText.substr(0, at) + "\"mine.vdb\"" + sceneText.substr(at + 10))
+      << "only material.vdb may change";
+  EXPECT_FALSE(fs::exists(p.recovery)) << "saved: no recovery file";
 }
 
 }  // namespace

@@ -396,5 +396,108 @@ TEST(PaintCli, BadOutputOrMissingStrokeFileExit2) {
   EXPECT_FALSE(fs::exists(f.dir / "out.png"));
 }
 
+/// Runs `sslpv paint` on `f` (scene and strokes already written).
+RunResult paint(const Files& f, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args{"paint", f.scene.string(), "--strokes", f.strokes.string(), "-o", f.output.string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return runSslpv(args);
+}
+
+std::size_t countLines(const std::string& text, const std::string& needle) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+  return n;
+}
+
+// A dab in the corner region of the object's box reach (within the radius of the bounds on
+// every axis, 1.4 radii from the box itself) painted voxels the object never shows, silently.
+TEST(PaintCli, DabsClearOfTheObjectWarnNamingThePointsButThePaintIsWritten) {
+  Files f;
+  writeText(f.scene, sceneJson().dump());
+  const glm::dmat4 restToWorld = loadScene(f.scene).transform.matrix();
+  const json strokes = {{"strokes",
+                         {{{"channel", "sigma_t"},
+                           {"mode", "set"},
+                           {"value", 3},
+                           {"radius", 1},
+                           {"points", {worldPoint(restToWorld, {4, 4, 4}), worldPoint(restToWorld, {5.4, 5.4, 5.4})}}}}}};
+  writeText(f.strokes, strokes.dump());
+  const RunResult run = paint(f);
+  ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+  EXPECT_NE(run.stderrText.find("sslpv: warning: " + f.strokes.string() +
+                                ": strokes[0].points: 1 of 2 points are farther than the brush radius (1) from the "
+                                "object and paint voxels it does not show (the first: points[1] ("),
+            std::string::npos)
+      << run.stderrText;
+  EXPECT_EQ(countLines(run.stderrText, "\n"), 1u) << run.stderrText;
+  EXPECT_TRUE(fs::exists(f.output));
+}
+
+// A ray stroke whose rays all miss changed nothing: warned by key, exit 2, no file written.
+TEST(PaintCli, AStrokeThatChangesNothingWarnsAndExits2WithoutWriting) {
+  Files f;
+  writeText(f.scene, sceneJson().dump());
+  const json strokes = {{"strokes",
+                         {{{"channel", "sigma_s"},
+                           {"mode", "add"},
+                           {"value", 0.3},
+                           {"radius", 0.4},
+                           {"rays", {{{"origin", {100, 20, 3}}, {"direction", {0, 1, 0}}}}}}}}};
+  writeText(f.strokes, strokes.dump());
+  writeText(f.output, kPreexisting);
+  const RunResult run = paint(f);
+  EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+  EXPECT_NE(run.stderrText.find("sslpv: warning: " + f.strokes.string() +
+                                ": strokes[0].rays: 1 of 1 rays missed the object and painted nothing\n"),
+            std::string::npos)
+      << run.stderrText;
+  EXPECT_NE(run.stderrText.find("sslpv: warning: " + f.strokes.string() + ": strokes[0]: changed no voxel\n"),
+            std::string::npos)
+      << run.stderrText;
+  EXPECT_NE(run.stderrText.find("sslpv: error: " + f.strokes.string() +
+                                ": no stroke changed any voxel (see the warnings above): nothing written to " +
+                                f.output.string() + "\n"),
+            std::string::npos)
+      << run.stderrText;
+  EXPECT_EQ(readText(f.output), kPreexisting);
+}
+
+// --update-scene changes the scene's material.vdb and not one other byte of the file.
+TEST(PaintCli, UpdateSceneNamesTheOutputAndKeepsTheRestOfTheFileByteForByte) {
+  Files f;
+  const std::string before =
+      "{\n"
+      "  \"units\": \"mm\",\n"
+      "  \"mesh\": {\"primitive\": \"box\", \"min\": [-5, -5, -5], \"max\": [5, 5, 5]},\n"
+      "  \"transform\": {\"translate\": [1, 2, 3], \"rotate_deg\": [0, 30, 0], \"scale\": 2},\n"
+      "  \"material\": {\n"
+      "    \"base\": {\"sigma_t\": [1.0, 1.2, 1.4], \"sigma_s\": [0.9, 1.0, 1.1], \"g\": 0.1}\n"
+      "  },\n"
+      "  \"lights\": [{\"type\": \"point\", \"position\": [20, 30, 40], \"intensity\": 1000}],\n"
+      "  \"camera\": {\"position\": [0, 10, 40], \"target\": [0, 0, 0], \"fov_y_deg\": 35,\n"
+      "             \"width\": 64, \"height\": 64}\n"
+      "}\n";
+  writeText(f.scene, before);
+  const glm::dmat4 restToWorld = loadScene(f.scene).transform.matrix();
+  const json strokes = {{"strokes",
+                         {{{"channel", "sigma_t"},
+                           {"mode", "set"},
+                           {"value", 3},
+                           {"radius", 1},
+                           {"points", {worldPoint(restToWorld, {0, 0, 0})}}}}}};
+  writeText(f.strokes, strokes.dump());
+  const RunResult run = paint(f, {"--update-scene"});
+  ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+  std::string expected = before;
+  const std::string base = "\"g\": 0.1}\n";
+  expected.replace(expected.find(base), base.size(), "\"g\": 0.1},\n    \"vdb\": \"out.vdb\"\n");
+  EXPECT_EQ(readText(f.scene), expected);
+  EXPECT_EQ(loadScene(f.scene).material.vdb, f.output.lexically_normal());
+  EXPECT_NE(run.stdoutText.find("wrote " + f.output.string() + " ("), std::string::npos) << run.stdoutText;
+  EXPECT_NE(run.stdoutText.find("wrote " + f.scene.string() + " (material.vdb now names out.vdb, "),
+            std::string::npos)
+      << run.stdoutText;
+}
+
 }  // namespace
 }  // namespace sslpv::test

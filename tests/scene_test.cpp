@@ -136,8 +136,7 @@ TEST(Scene, OptionalKeysTakeDocumentedDefaults) {
   EXPECT_EQ(s.material.base.g, 0.0f);
   EXPECT_EQ(s.camera.up, glm::dvec3(0, 1, 0));
   EXPECT_EQ(s.lpv.resolution, 32);
-  EXPECT_EQ(s.lpv.steps, 8);
-  EXPECT_FALSE(s.lpv.autoSteps);
+  EXPECT_TRUE(s.lpv.autoSteps) << "no lpv block: propagate until converged, not a fixed 8 steps";
   EXPECT_EQ(s.lpv.shadowMap, 256);
   EXPECT_EQ(s.mesh.kind, MeshSource::Kind::Sphere);
   EXPECT_EQ(s.mesh.center, glm::dvec3(0.0));
@@ -154,6 +153,10 @@ TEST(Scene, PartialTransformAndLpvBlocksDefaultTheRest) {
   EXPECT_EQ(s.lpv.steps, 20);
   EXPECT_EQ(s.lpv.resolution, 32);
   EXPECT_EQ(s.lpv.shadowMap, 256);
+  j["lpv"] = {{"resolution", 16}};
+  s = parse(j);
+  EXPECT_EQ(s.lpv.steps, 8);
+  EXPECT_FALSE(s.lpv.autoSteps) << "an lpv block without steps keeps the fixed default";
 }
 
 TEST(Scene, ExplicitBaseGDefaultsToZero) {

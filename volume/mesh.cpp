@@ -473,7 +473,7 @@ std::size_t orientOutward(TriangleMesh& mesh) {
 
 }  // namespace
 
-TriangleMesh loadMesh(const MeshSource& source, const Transform& transform) {
+TriangleMesh loadMesh(const MeshSource& source, const Transform& transform, bool warnReoriented) {
   TriangleMesh mesh;
   switch (source.kind) {
     case MeshSource::Kind::Box: mesh = makeBox(source); break;
@@ -495,7 +495,7 @@ TriangleMesh loadMesh(const MeshSource& source, const Transform& transform) {
                        " after the transform, outside the coordinate range " + coordinateRange());
     mesh.positions[i] = glm::vec3(world);
   }
-  if (const std::size_t flipped = orientOutward(mesh))
+  if (const std::size_t flipped = orientOutward(mesh); flipped > 0 && warnReoriented)
     std::cerr << "sslpv: warning: " << mesh.name << ": " << flipped << " of " << mesh.triangles.size()
               << " triangles faced inward or against their neighbours; reoriented them to face outward\n";
   return mesh;

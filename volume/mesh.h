@@ -40,8 +40,9 @@ struct MeshTopology {
 
 /// Loads the scene's mesh (file via assimp, or a primitive), welds vertices and applies
 /// `transform`. Throws InputError for a missing/unreadable/empty file or degenerate
-/// primitive parameters.
-TriangleMesh loadMesh(const MeshSource& source, const Transform& transform);
+/// primitive parameters. Triangles facing inward are turned outward, with a warning on
+/// stderr unless `warnReoriented` is false (a second load of a mesh already reported).
+TriangleMesh loadMesh(const MeshSource& source, const Transform& transform, bool warnReoriented = true);
 
 MeshTopology analyzeTopology(const TriangleMesh& mesh);
 

@@ -66,7 +66,17 @@ class SceneReader : public StrictJsonReader {
   }
 
   /// RGB radiometric quantities and coefficients: finite, non-negative, at most `max`.
+  /// One number means the same value in every channel, as in stroke files: a grey
+  /// light or material should not need three copies of one number.
   glm::dvec3 nonNegativeRgb(const json& value, const std::string& path, double max) const {
+    if (value.is_number()) {
+      const double x = number(value, path);
+      if (x < 0.0) fail(path, "expected a non-negative number, got " + formatNumber(x));
+      requireRange(x, path, 0.0, max);
+      return glm::dvec3(x);
+    }
+    if (!value.is_array())
+      fail(path, "expected a non-negative number or an array of 3 non-negative numbers, got " + describeType(value));
     glm::dvec3 result = vec3(value, path, "non-negative numbers");
     for (int i = 0; i < 3; ++i) {
       if (result[i] < 0.0)
@@ -354,7 +364,13 @@ Scene parseScene(const std::string& jsonText, const fs::path& file) {
     scene.lights.push_back(parseLight(in, lights[i], indexPath("lights", i)));
 
   scene.camera = parseCamera(in, in.required(root, "", "camera"));
-  if (const json* v = in.optional(root, "lpv")) scene.lpv = parseLpv(in, *v);
+  if (const json* v = in.optional(root, "lpv")) {
+    scene.lpv = parseLpv(in, *v);
+  } else {
+    // A scene that says nothing about the lattice asks for a converged image, not for
+    // whatever a fixed step count happens to reach (8 steps leave a large object dark).
+    scene.lpv.autoSteps = true;
+  }
   return scene;
 }
 

@@ -1,5 +1,5 @@
 // The editor window's keyboard: brush controls, undo/redo, files, help, quitting, and the
-// typed path of "export material set". Kept apart from the window's layout and painting.
+// typed paths of "export material set" and "save as". Kept apart from the window's layout and painting.
 #include <vtkActor.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -12,33 +12,61 @@
 
 namespace sslpv {
 
-void EditWindow::startExportPrompt() {
+void EditWindow::startPrompt(PromptKind kind) {
   const std::filesystem::path& scene = session_.paths().scene;
-  prompt_ = (scene.parent_path() / (scene.stem().string() + "_export.vdb")).string();
-  showMessage("export to: " + *prompt_ + "_   (Enter writes, Esc cancels)", false);
+  promptKind_ = kind;
+  // Empty, not prefilled: typing must not append to a suggested path.
+  prompt_ = std::string();
+  replaceArmed_.clear();
+  promptSuggestion_ =
+      (scene.parent_path() / (scene.stem().string() + (kind == PromptKind::Export ? "_export.vdb" : "_painted.vdb")))
+          .string();
+  showPrompt();
+}
+
+void EditWindow::showPrompt() {
+  const char* what = promptKind_ == PromptKind::Export ? "export material set to" : "save as";
+  showMessage(std::string(what) + ": " + *prompt_ + "_\n(Enter: " + (prompt_->empty() ? promptSuggestion_ : *prompt_) +
+                  ", Esc cancels)",
+              false);
 }
 
 bool EditWindow::handlePromptKey(const std::string& keySym, char keyCode) {
   if (keySym == "Escape") {
     prompt_.reset();
-    showMessage("export cancelled", false);
-  } else if (keySym == "Return" || keySym == "KP_Enter") {
-    const std::string path = *prompt_;
-    prompt_.reset();
-    try {
-      session_.exportMaterialSet(path);
-      showMessage("exported material set to " + path, false);
-    } catch (const std::exception& e) {
-      showMessage(std::string("export failed: ") + e.what(), true);
-    }
-  } else {
+    showMessage(promptKind_ == PromptKind::Export ? "export cancelled" : "save as cancelled", false);
+    return true;
+  }
+  if (keySym != "Return" && keySym != "KP_Enter") {
     if (keySym == "BackSpace") {
       if (!prompt_->empty()) prompt_->pop_back();
     } else if (keyCode >= 32 && keyCode < 127) {
       prompt_->push_back(keyCode);
     }
-    showMessage("export to: " + *prompt_ + "_   (Enter writes, Esc cancels)", false);
+    replaceArmed_.clear();
+    showPrompt();
+    return true;
   }
+  const std::string path = prompt_->empty() ? promptSuggestion_ : *prompt_;
+  try {
+    if (promptKind_ == PromptKind::Export) {
+      session_.exportMaterialSet(path);
+      showMessage("exported material set to " + path, false);
+    } else {
+      // A second Enter on the same path is the user's answer to "replace it?".
+      session_.saveAs(path, replaceArmed_ == path);
+      showMessage("saved as " + path + " (the scene now uses it)", false);
+    }
+    prompt_.reset();
+  } catch (const SaveNeedsConfirmation& e) {
+    replaceArmed_ = path;
+    showMessage(std::string(e.what()) + "\nEnter again replaces it, Esc cancels", true);
+  } catch (const std::exception& e) {
+    prompt_.reset();
+    showMessage(std::string(promptKind_ == PromptKind::Export ? "export failed: " : "save as failed: ") + e.what(),
+                true);
+  }
+  updateStatus();
   return true;
 }
 
@@ -55,6 +83,8 @@ bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char k
     return true;
   }
   if (key != "q" && key != "e") quitArmed_ = false;
+  const bool saveWasArmed = saveArmed_;
+  saveArmed_ = false;
   const std::string lower = key.size() == 1 ? std::string(1, char(std::tolower(key[0]))) : key;
   bool handled = true;
   if (ctrl) {
@@ -62,10 +92,12 @@ bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char k
       afterChange(session_.undo(), "undo");
     } else if ((lower == "z" && shift) || lower == "y") {
       afterChange(session_.redo(), "redo");
+    } else if (lower == "s" && shift) {
+      startPrompt(PromptKind::SaveAs);
     } else if (lower == "s") {
-      save();
+      save(saveWasArmed);
     } else if (lower == "e") {
-      startExportPrompt();
+      startPrompt(PromptKind::Export);
     } else {
       handled = false;
     }

@@ -60,7 +60,8 @@ const char* kHelpText =
     "  x            mirror: off, x, y, z\n"
     "  i / I        surface depth deeper / shallower\n"
     "  Ctrl+Z       undo        Ctrl+Y, Ctrl+Shift+Z   redo\n"
-    "  Ctrl+S       save        Ctrl+E   export material set (type a path)\n"
+    "  Ctrl+S       save        Ctrl+Shift+S  save as (type a path)\n"
+    "  Ctrl+E       export a copy of the material set (type a path)\n"
     "  R / D        recover / discard unsaved work from a previous session\n"
     "  h, ?, F1     this help   q, e   quit (asks when there are unsaved changes)\n"
     "  VTK camera keys: r reset, f fly to, w wireframe, s surface, 3 stereo";
@@ -207,7 +208,8 @@ void EditWindow::buildScene() {
   preview_->AddViewProp(previewActor_);
 
   status_ = makeText(overlay_, 13, 0.005, 0.012);
-  message_ = makeText(overlay_, 14, 0.005, 0.965);
+  message_ = makeText(overlay_, 14, 0.005, 0.99);
+  message_->GetTextProperty()->SetVerticalJustificationToTop();
   unsavedMarker_ = makeText(overlay_, 14, 0.005, 0.93);
   previewLabel_ = makeText(overlay_, 12, 0.505, 0.965);
   previewLabel_->GetTextProperty()->SetColor(0.8, 0.8, 0.8);
@@ -272,10 +274,38 @@ void EditWindow::updateStatus() {
 }
 
 void EditWindow::showMessage(const std::string& text, bool error) {
-  message_->SetInput(text.c_str());
+  // Wrapped to the left half of the window (the 3D view), so a long error does not run
+  // over the preview on the right; lines grow downward from the top edge.
+  const int width = window_ ? window_->GetSize()[0] : 0;
+  const std::size_t columns = std::max<std::size_t>(30, std::size_t(width > 0 ? width / 2 / 9 : 60));
+  std::string wrapped;
+  std::size_t lineLength = 0;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    std::size_t end = text.find_first_of(" \n", at);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(at, end - at);
+    if (lineLength > 0 && lineLength + 1 + word.size() > columns) {
+      wrapped += "\n";
+      lineLength = 0;
+    } else if (lineLength > 0) {
+      wrapped += " ";
+      ++lineLength;
+    }
+    wrapped += word;
+    lineLength += word.size();
+    if (end < text.size() && text[end] == '\n') {
+      wrapped += "\n";
+      lineLength = 0;
+    }
+    at = end + 1;
+  }
+  message_->SetInput(wrapped.c_str());
   if (error) {
     message_->GetTextProperty()->SetColor(1.0, 0.3, 0.3);
-    std::fprintf(stderr, "sslpv edit: %s\n", text.c_str());
+    std::string line = text;
+    std::replace(line.begin(), line.end(), '\n', ' ');
+    std::fprintf(stderr, "sslpv edit: %s\n", line.c_str());
   } else {
     message_->GetTextProperty()->SetColor(0.9, 0.9, 0.9);
   }
@@ -430,10 +460,13 @@ bool EditWindow::moveSliceAt(int x, int y, int steps) {
   return true;
 }
 
-void EditWindow::save() {
+void EditWindow::save(bool replaceConfirmed) {
   try {
-    session_.save();
+    session_.save(replaceConfirmed);
     showMessage("saved " + session_.paths().saveTarget.filename().string(), false);
+  } catch (const SaveNeedsConfirmation& e) {
+    saveArmed_ = true;
+    showMessage(std::string(e.what()) + "\nCtrl+S again replaces it; Ctrl+Shift+S saves as another file", true);
   } catch (const std::exception& e) {
     // The session kept its state and the previous file: say so, keep working.
     showMessage(std::string("save failed, nothing lost (changes still in memory): ") + e.what(), true);

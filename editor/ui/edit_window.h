@@ -74,8 +74,10 @@ class EditWindow {
   void updatePreview();
   void updateStatus();
   void afterChange(const std::optional<StrokeResult>& result, const char* what);
-  void save();
-  void startExportPrompt();
+  void save(bool replaceConfirmed);
+  enum class PromptKind { Export, SaveAs };
+  /// Starts typing a path; the prompt starts empty and Enter on empty takes `suggestion`.
+  void startPrompt(PromptKind kind);
   bool handlePromptKey(const std::string& keySym, char keyCode);
   // The colour picker (editor/ui/colour_panel.cpp).
   void buildSwatches();
@@ -85,6 +87,7 @@ class EditWindow {
   void startColourEntry();
   void showColourEntry();
   void handleColourEntryKey(const std::string& keySym, char keyCode);
+  void showPrompt();
   void maybeAutosave(bool strokeJustEnded);
   SurfaceRay rayAt(int x, int y) const;
   /// Shows the brush (a wire sphere of its radius) at the surface or slice point under
@@ -116,10 +119,14 @@ class EditWindow {
   bool quit_ = false;
   bool quitArmed_ = false;
   bool recoveryPending_ = false;
-  std::optional<std::string> prompt_;  ///< export path being typed
   std::vector<vtkSmartPointer<vtkTextActor>> swatchActors_;  ///< the Jensen swatches, then the brush's
   std::optional<int> colourEntryField_;  ///< typed entry: 0 colour, 1 scatter distance, 2 g
   std::string colourEntryText_;
+  std::optional<std::string> prompt_;  ///< export / save-as path being typed
+  PromptKind promptKind_ = PromptKind::Export;
+  std::string promptSuggestion_;       ///< what Enter on an empty prompt writes
+  std::string replaceArmed_;           ///< a path the user was asked about: writing it again replaces it
+  bool saveArmed_ = false;             ///< Ctrl+S was refused pending confirmation: the next one replaces
   std::chrono::steady_clock::time_point lastChange_;
   std::string previewTiming_;
 };

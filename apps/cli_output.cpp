@@ -1,0 +1,61 @@
+#include "apps/cli_output.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+#include <utility>
+
+namespace sslpv {
+
+void printWrote(const std::string& file, const std::string& detail, CliClock::time_point start) {
+  const long long ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(CliClock::now() - start).count();
+  std::printf("wrote %s (%s%s%lld ms)\n", file.c_str(), detail.c_str(), detail.empty() ? "" : ", ", ms);
+  std::fflush(stdout);
+}
+
+std::string imageSizeText(const Image& image) {
+  return std::to_string(image.width) + "x" + std::to_string(image.height);
+}
+
+void printWarning(std::string message) {
+  for (char& c : message)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::cerr << "sslpv: warning: " << message << std::endl;
+}
+
+void warnIfBlack(const Image& image, const std::string& what) {
+  // Far below anything a tone mapper or a float EXR reader would show as non-black.
+  constexpr float kBlack = 1e-30f;
+  for (const glm::vec3& p : image.pixels)
+    if (p.r > kBlack || p.g > kBlack || p.b > kBlack) return;
+  printWarning(what +
+               ": the image is black (every pixel is zero): check that the camera and the lights are outside "
+               "the object and face it, the light intensities, and transform.scale against the units");
+}
+
+ProgressLine::ProgressLine(std::string label) : ProgressLine(std::move(label), ::isatty(STDERR_FILENO) == 1) {}
+
+ProgressLine::ProgressLine(std::string label, bool terminal) : label_(std::move(label)), terminal_(terminal) {}
+
+void ProgressLine::update(std::size_t done, std::size_t total) {
+  if (!terminal_ || total == 0) return;
+  const int percent = int(100.0 * double(done) / double(total));
+  if (percent == lastPercent_) return;
+  lastPercent_ = percent;
+  const double elapsed = std::chrono::duration<double>(CliClock::now() - start_).count();
+  const double eta = done > 0 ? elapsed * double(total - done) / double(done) : 0.0;
+  std::fprintf(stderr, "\r%s: %3d%%  %.1f s elapsed, ETA %.1f s   ", label_.c_str(), percent, elapsed, eta);
+  std::fflush(stderr);
+}
+
+void ProgressLine::finish(const std::string& summary) {
+  const double elapsed = std::chrono::duration<double>(CliClock::now() - start_).count();
+  // On a terminal the summary replaces the progress line (padded over its tail).
+  std::fprintf(stderr, "%s%s: %s (%.1f s)%s\n", terminal_ ? "\r" : "", label_.c_str(), summary.c_str(), elapsed,
+               terminal_ ? "            " : "");
+  std::fflush(stderr);
+}
+
+}  // namespace sslpv
