@@ -102,7 +102,7 @@ inline RandomScene randomScene(std::uint64_t seed, int side) {
     size = r.uniform(2.0, 10.0);
     j << "{\"primitive\": \"sphere\", \"center\": [0, 0, 0], \"radius\": " << size << "}";
   } else {
-    const double hx = r.uniform(1.0, 10.0), hy = r.uniform(1.0, 10.0), hz = r.uniform(1.0, 10.0);
+    const double hx = r.uniform(2.0, 10.0), hy = r.uniform(2.0, 10.0), hz = r.uniform(2.0, 10.0);
     size = std::max({hx, hy, hz});
     j << "{\"primitive\": \"box\", \"min\": " << vec3Json(-hx, -hy, -hz) << ", \"max\": " << vec3Json(hx, hy, hz)
       << "}";
@@ -148,7 +148,7 @@ inline RandomScene randomScene(std::uint64_t seed, int side) {
     }
   }
   const double theta = r.uniform(0.0, 6.283185307179586), phi = r.uniform(-1.2, 1.2);
-  const double d = worldSize * r.uniform(2.5, 5.0);
+  const double d = worldSize * r.uniform(2.0, 3.5);
   j << "], \"camera\": {\"position\": "
     << vec3Json(cx + d * std::cos(phi) * std::cos(theta), cy + d * std::sin(phi),
                 cz + d * std::cos(phi) * std::sin(theta))
