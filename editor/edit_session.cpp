@@ -188,6 +188,10 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
     m.paths.saveUpdatesScene = true;
   }
 
+  // Temporaries of a session that was killed mid-save: nothing reads them, and the next
+  // save of each file might be long in coming.
+  for (const fs::path& file : {m.paths.saveTarget, m.paths.recovery, m.paths.scene}) removeStaleTemporaries(file);
+
   PaintTarget target = makePaintTarget(m.scene);
   m.targetTemplate = target;
   m.targetTemplate.set.reset();
@@ -344,25 +348,12 @@ void EditSession::save() {
     // Refuse to write a scene the loader would reject (the file may have changed on disk).
     parseScene(rewritten, sceneFile);
 
-    // The material goes to a temporary sibling, the scene is replaced, then the material
-    // is renamed into place: a failure at any step leaves both previous files.
-    bool sceneWritten = false;
-    try {
-      writeAtomically(target, [&](const fs::path& temp) {
-        saveMaterialSet(out, temp);
-        writeAtomically(sceneFile, [&](const fs::path& sceneTemp) { writeFile(sceneTemp, rewritten, sceneFile); });
-        sceneWritten = true;
-      });
-    } catch (...) {
-      if (sceneWritten) {
-        // The material was not renamed into place: the scene must not name it.
-        try {
-          writeAtomically(sceneFile, [&](const fs::path& sceneTemp) { writeFile(sceneTemp, original, sceneFile); });
-        } catch (...) {
-        }
-      }
-      throw;
-    }
+    // Both files go to temporaries first, then the material is renamed into place before
+    // the scene that names it: killed between the two renames, the previous scene (which
+    // does not name the new file) stays, never a scene naming a file that is not there
+    // yet. A failure before the renames leaves both previous files.
+    writeAtomicallyTogether({{target, [&](const fs::path& temp) { saveMaterialSet(out, temp); }},
+                             {sceneFile, [&](const fs::path& temp) { writeFile(temp, rewritten, sceneFile); }}});
     m.scene.material.vdb = target;
     m.paths.saveUpdatesScene = false;
   }

@@ -7,7 +7,9 @@
 // gets <scene dir>/<scene stem>_material.vdb, and Save then also rewrites the scene JSON
 // so that material.vdb names it (keys and values kept, key order kept). Every write is
 // atomic (temporary file + rename): a failed save leaves the previous file and the
-// in-memory state (painted voxels, history, unsaved flag) exactly as they were.
+// in-memory state (painted voxels, history, unsaved flag) exactly as they were. A session
+// killed mid-write (SIGKILL) leaves at most a temporary beside the file, which the next
+// session removes when it opens the scene.
 //
 // Recovery. While there are unsaved changes the window calls autosave() a few seconds
 // after the last change; it writes the current set to <scene file>.recovery.vdb (same
