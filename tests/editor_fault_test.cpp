@@ -429,5 +429,123 @@ TEST(EditorFault, KillAtEveryRenameLosesNothing) {
 #endif
 }
 
+// ---- The real editor ------------------------------------------------------------------
+
+std::string editorSkipReason() {
+#ifndef SSLPV_EDIT_BINARY
+  return "the editor (sslpv-edit) was not built: VTK was not found at configure time";
+#else
+  if (runProgram({"sh", "-c", "command -v xvfb-run"}).exitCode != 0)
+    return "xvfb-run is not installed (Debian package xvfb): the editor needs an X display";
+  return {};
+#endif
+}
+
+/// The pid of the first process below `root` whose command name is `name`, or -1.
+pid_t findDescendant(pid_t root, const std::string& name) {
+  std::map<pid_t, std::vector<pid_t>> children;
+  std::map<pid_t, std::string> names;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string dir = entry.path().filename().string();
+    if (dir.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::string stat;
+    try {
+      stat = readText(entry.path() / "stat");
+    } catch (...) {
+      continue;  // gone meanwhile
+    }
+    const std::size_t open = stat.find('('), close = stat.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) continue;
+    std::istringstream rest(stat.substr(close + 2));
+    char state = 0;
+    pid_t parent = 0;
+    rest >> state >> parent;
+    const pid_t pid = pid_t(std::stol(dir));
+    children[parent].push_back(pid);
+    names[pid] = stat.substr(open + 1, close - open - 1);
+  }
+  std::vector<pid_t> todo{root};
+  while (!todo.empty()) {
+    const pid_t p = todo.back();
+    todo.pop_back();
+    for (pid_t c : children[p]) {
+      if (names[c] == name) return c;
+      todo.push_back(c);
+    }
+  }
+  return -1;
+}
+
+/// A vtkInteractorEventRecorder script: `drags` horizontal drags across the 3D view's
+/// centre (window 960x600: the 3D view is x 0..480, y 204..600), each in 8 moves.
+std::string dragScript(int drags) {
+  std::ostringstream s;
+  s << "# StreamVersion 1.1\n";
+  for (int d = 0; d < drags; ++d) {
+    const int y = 380 + (d % 5) * 10;
+    s << "MouseMoveEvent 200 " << y << " 0 0 0 0\nLeftButtonPressEvent 200 " << y << " 0 0 0 0\n";
+    for (int i = 1; i <= 8; ++i) s << "MouseMoveEvent " << 200 + 10 * i << " " << y << " 0 0 0 0\n";
+    s << "LeftButtonReleaseEvent 280 " << y << " 0 0 0 0\n";
+  }
+  return s.str();
+}
+
+// `sslpv edit` painting with an autosave after every stroke, killed -9 at a seeded moment
+// after its first autosave while it keeps painting; the recovery file must read back
+// valid, and a start with --recover that saves (Ctrl+S) must write exactly that set and
+// leave neither the recovery file nor a temporary behind.
+TEST(EditorFault, RealEditorKilledWhilePaintingRecoversItsLastAutosave) {
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << "SKIPPED: " << why;
+  Project p(false);
+  const fs::path recovery = p.dir / "scene.json.recovery.vdb";
+  TempDir logs;
+  writeText(logs / "paint.txt", dragScript(40));
+  const std::vector<std::string> command = {"xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", SSLPV_BINARY,
+                                            "edit", p.scene.string(), "--backend", "cpu", "--size", "960x600",
+                                            "--autosave-seconds", "0", "--play", (logs / "paint.txt").string()};
+  std::vector<char*> argv;
+  std::vector<std::string> args = command;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, (logs / "editor.log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t xvfb = -1;
+  ASSERT_EQ(posix_spawnp(&xvfb, "xvfb-run", &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+
+  // The first autosave shows the window is painting; then a seeded moment into the rest.
+  const auto deadline = Clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(recovery) && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const pid_t editor = findDescendant(xvfb, "sslpv-edit");
+  const bool autosaved = fs::exists(recovery);
+  std::mt19937 rng(20261203);
+  std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(200, 1500)(rng)));
+  const bool stillPainting = editor > 0 && ::kill(editor, 0) == 0;
+  if (editor > 0) ::kill(editor, SIGKILL);
+  int status = 0;
+  ::waitpid(xvfb, &status, 0);
+  ASSERT_TRUE(autosaved) << "no autosave within 120 s; editor log: " << readText(logs / "editor.log");
+  ASSERT_GT(editor, 0) << "sslpv-edit not found under xvfb-run";
+  ASSERT_TRUE(stillPainting) << "the editor ended before it was killed: " << readText(logs / "editor.log");
+
+  std::shared_ptr<const MaterialSet> autosave;
+  ASSERT_NO_THROW(autosave = loadMaterialSet(recovery)) << "the recovery file must read back (not truncated)";
+  ASSERT_GT(autosave->sigmaT->activeVoxelCount(), 0u);
+
+  writeText(logs / "save.txt",
+            "# StreamVersion 1.1\nKeyPressEvent 240 402 2 19 1 s\nCharEvent 240 402 2 19 1 s\n"
+            "KeyReleaseEvent 240 402 2 19 1 s\n");
+  const RunResult r = runProgram({"xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", SSLPV_BINARY, "edit",
+                                  p.scene.string(), "--backend", "cpu", "--size", "960x600", "--recover", "--play",
+                                  (logs / "save.txt").string(), "--exit"});
+  ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  ASSERT_TRUE(fs::exists(p.material)) << "Ctrl+S after --recover wrote nothing: " << r.stderrText;
+  EXPECT_TRUE(sameVoxels(*loadMaterialSet(p.material), *autosave)) << "the save must hold the recovered autosave";
+  EXPECT_FALSE(fs::exists(recovery)) << "the save should delete the recovery file";
+  EXPECT_EQ(temporariesIn(p.dir.path()), std::vector<std::string>{});
+}
+
 }  // namespace
 }  // namespace sslpv::test
