@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -164,7 +165,7 @@ class Worker {
     while (Clock::now() < deadline) {
       for (; consumed_ < lines_.size(); ++consumed_)
         if (lines_[consumed_] == line) return ++consumed_, true;
-      if (!readSome(1000)) return false;
+      if (readSome(1000) == Read::End) return false;
     }
     return false;
   }
@@ -173,7 +174,7 @@ class Worker {
 
   /// Waits for the worker to end and returns everything it announced.
   Progress finish(int* status = nullptr) {
-    while (readSome(120000)) {
+    while (readSome(120000) == Read::Data) {
     }
     int s = 0;
     ::waitpid(pid_, &s, 0);
@@ -187,17 +188,21 @@ class Worker {
   const std::vector<std::string>& lines() const { return lines_; }
 
  private:
-  /// False at end of file (the worker is gone) or after `timeoutMs` without data.
-  bool readSome(int timeoutMs) {
+  enum class Read { Data, Timeout, End };
+  /// End: the worker is gone (end of file). A busy machine may stall the worker for
+  /// seconds, so a timeout is not an end.
+  Read readSome(int timeoutMs) {
     pollfd p{readFd_, POLLIN, 0};
-    if (::poll(&p, 1, timeoutMs) <= 0) return false;
+    const int ready = ::poll(&p, 1, timeoutMs);
+    if (ready == 0) return Read::Timeout;
+    if (ready < 0) return errno == EINTR ? Read::Timeout : Read::End;
     char buffer[4096];
     const ssize_t n = ::read(readFd_, buffer, sizeof buffer);
-    if (n <= 0) return false;
+    if (n <= 0) return Read::End;
     partial_.append(buffer, std::size_t(n));
     for (std::size_t end; (end = partial_.find('\n')) != std::string::npos; partial_.erase(0, end + 1))
       lines_.push_back(partial_.substr(0, end));
-    return true;
+    return Read::Data;
   }
 
   pid_t pid_ = -1;
@@ -333,7 +338,7 @@ std::map<std::string, double> medianPhaseTimes(const Project& project, int strok
 // Kill points spread over the three phases: per kill, a phase, which of its occurrences
 // (strokes 1..9) and a moment within it (uniform over 1.2x its median duration, measured
 // by an unkilled run). A kill that lands after the phase ended still tests the state
-// between steps; the test requires that most kills land inside their phase.
+// between steps; the test requires that at least a third land inside their phase.
 TEST(EditorFault, KillAtRandomMomentsLosesNoSaveAndNoAutosave) {
   constexpr int kStrokes = 9, kKills = 24;
   TempDir logs;
