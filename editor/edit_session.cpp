@@ -198,6 +198,10 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
     m.paths.saveUpdatesScene = true;
   }
 
+  // Temporaries of a session that was killed mid-save: nothing reads them, and the next
+  // save of each file might be long in coming.
+  for (const fs::path& file : {m.paths.saveTarget, m.paths.recovery, m.paths.scene}) removeStaleTemporaries(file);
+
   PaintTarget target = makePaintTarget(m.scene);
   // A set some other tool wrote (an example's hand-made set) is not replaced without the
   // user's word, nor is an existing file the scene does not name.
@@ -389,7 +393,10 @@ void EditSession::writeSaved(const fs::path& target, bool nameInScene) {
     }
     // Refuse to write a scene the loader would reject (the file may have changed on disk).
     const Scene written = parseScene(text, sceneFile);
-    // Every temporary is written before either file is replaced: a failure leaves both.
+    // Both files go to temporaries first, then the material is renamed into place before
+    // the scene that names it: killed between the two renames, the previous scene (which
+    // does not name the new file) stays, never a scene naming a file that is not there
+    // yet. A failure before the renames leaves both previous files.
     writeAtomicallyTogether({{target, [&](const fs::path& temp) { saveMaterialSet(out, temp); }},
                              sceneTextOutput(sceneFile, text)});
     m.scene.material.vdb = written.material.vdb;

@@ -12,7 +12,8 @@
 // painting tools did not write (an example's hand-made set) or an existing file the scene
 // does not name. Every write is atomic (temporary file + rename): a failed save leaves
 // the previous files and the in-memory state (painted voxels, history, unsaved flag)
-// exactly as they were.
+// exactly as they were. A session killed mid-write (SIGKILL) leaves at most a temporary
+// beside the file, which the next session removes when it opens the scene.
 //
 // Recovery. While there are unsaved changes the window calls autosave() a few seconds
 // after the last change; it writes the current set to <scene file>.recovery.vdb (same

@@ -2,10 +2,13 @@
 // removed when a signal ends the process in the middle of a write.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <fstream>
 #include <stdexcept>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "test_support.h"
 #include "volume/atomic_file.h"
@@ -69,6 +72,30 @@ TEST(AtomicFileDeathTest, SigtermDuringAWriteRemovesTheTemporaryAndEndsBySigterm
       ::testing::KilledBySignal(SIGTERM), "");
   EXPECT_EQ(readText(dir / "out"), "old");
   EXPECT_EQ(temporaries(dir.path()), 0u) << "the killed writer's temporary is left behind";
+}
+
+// A writer killed -9 leaves "<target>.tmp-<pid>-<n>", or when it wrote its temporary
+// atomically in turn "<target>.tmp-<pid>-<n>.tmp-<pid>-<m>": both go once the pid is gone;
+// a live process's temporary and names of another shape stay.
+TEST(AtomicFile, StaleTemporariesOfGoneWritersAreRemovedNestedOnesToo) {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);
+  const std::string dead = std::to_string(child), alive = std::to_string(::getppid());
+  TempDir dir;
+  for (const std::string& name : {"out.tmp-" + dead + "-0", "out.tmp-" + dead + "-1.tmp-" + dead + "-2",
+                                  "out.tmp-" + alive + "-3", "out.tmp-" + dead + "-4.tmp-" + alive + "-5",
+                                  std::string("out.tmp-x-6")})
+    writeText(dir / name, "partial");
+  removeStaleTemporaries(dir / "out");
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir.path())) left.push_back(entry.path().filename().string());
+  std::sort(left.begin(), left.end());
+  std::vector<std::string> expected = {"out.tmp-" + alive + "-3", "out.tmp-" + dead + "-4.tmp-" + alive + "-5",
+                                       "out.tmp-x-6"};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(left, expected);
 }
 
 TEST(AtomicFile, WriteFailureNamesTheFileAndTheSystemReason) {

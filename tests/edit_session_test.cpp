@@ -16,6 +16,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "material_compare.h"
 #include "test_support.h"
 #include "volume/cpu_renderer.h"
 #include "volume/error.h"
@@ -56,30 +57,6 @@ Stroke darkStroke(double x = 0.0) {
   s.brush.radius = 1.5;
   s.points = {{x, 0.0, 4.0}, {x + 1.0, 1.0, 4.0}};
   return s;
-}
-
-template <class GridT>
-::testing::AssertionResult sameGrid(const GridT* a, const GridT* b, const char* name) {
-  if (!a || !b) return a == b ? ::testing::AssertionSuccess() : ::testing::AssertionFailure() << name << " missing";
-  if (a->activeVoxelCount() != b->activeVoxelCount())
-    return ::testing::AssertionFailure() << name << ": active voxel counts " << a->activeVoxelCount() << " vs "
-                                         << b->activeVoxelCount();
-  if (!(a->transform() == b->transform())) return ::testing::AssertionFailure() << name << ": transforms differ";
-  auto accB = b->getConstAccessor();
-  for (auto it = a->cbeginValueOn(); it; ++it) {
-    typename GridT::ValueType vb;
-    const typename GridT::ValueType va = *it;
-    if (!accB.probeValue(it.getCoord(), vb) || std::memcmp(&va, &vb, sizeof va) != 0)
-      return ::testing::AssertionFailure() << name << " voxel " << it.getCoord() << " differs";
-  }
-  return ::testing::AssertionSuccess();
-}
-
-/// Active states and stored bits of every active voxel of all three grids are identical.
-::testing::AssertionResult sameVoxels(const MaterialSet& a, const MaterialSet& b) {
-  if (auto r = sameGrid(a.sigmaT.get(), b.sigmaT.get(), "sigma_t"); !r) return r;
-  if (auto r = sameGrid(a.sigmaS.get(), b.sigmaS.get(), "sigma_s"); !r) return r;
-  return sameGrid(a.g.get(), b.g.get(), "g");
 }
 
 std::vector<std::string> listDir(const fs::path& dir) {

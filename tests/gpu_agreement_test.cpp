@@ -16,68 +16,21 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <random>
 #include <sstream>
 
-#include "gpu/vulkan_renderer.h"
+#include "gpu_agreement_check.h"
 #include "gpu_test_fixture.h"
-#include "image_agreement.h"
 #include "test_support.h"
-#include "volume/cpu_renderer.h"
-#include "volume/mesh.h"
-#include "volume/ray_scene.h"
 #include "volume/scene.h"
 
 namespace {
 using namespace sslpv;
 
-double meanRadiance(const Image& image) {
-  double sum = 0.0;
-  std::size_t lit = 0;
-  for (const glm::vec3& p : image.pixels)
-    if (p != glm::vec3(0.0f)) {
-      sum += (p.x + p.y + p.z) / 3.0;
-      ++lit;
-    }
-  return lit ? sum / double(lit) : 0.0;
-}
-
 class GpuAgreement : public test::GpuTest {
  protected:
-  void expectAgreement(const Scene& scene) {
-    CpuRenderer cpu(scene);
-    gpu::VulkanRenderer vulkan(scene, device());
-    RenderReport cpuReport, gpuReport;
-    const Image cpuImage = cpu.render(scene.lpv, &cpuReport);
-    const Image gpuImage = vulkan.render(scene.lpv, &gpuReport);
-    ASSERT_EQ(cpuImage.pixels.size(), gpuImage.pixels.size());
-    const RayScene rays(loadMesh(scene.mesh, scene.transform));
-    const test::ImageAgreement a =
-        test::compareImages(gpuImage, cpuImage, vulkan.readTriangles(), test::cpuTriangles(scene.camera, rays),
-                            1e-3 * meanRadiance(cpuImage));
-    char line[400];
-    std::snprintf(line, sizeof line,
-                  "%s: %zu object pixels (%zu silhouette, %zu edge), mean relative %.3g %%, worst interior %.3g %% "
-                  "at (%d, %d), background mismatches %zu, surface mismatches %zu",
-                  scene.file.filename().string().c_str(), a.objectPixels, a.silhouette, a.edge,
-                  100.0 * a.meanRelative, 100.0 * a.worstInterior, a.worstX, a.worstY, a.backgroundMismatches,
-                  a.surfaceMismatches);
-    std::printf("%s\n", line);
-    SCOPED_TRACE(line);
-    ASSERT_GT(a.interior, cpuImage.pixels.size() / 100) << "the object must be in view, or nothing is compared";
-    EXPECT_EQ(gpuReport.activeCells, cpuReport.activeCells) << "both backends must see the same occupied cells";
-    EXPECT_LE(a.meanRelative, 0.01);
-    // The single-scattering term makes hard choices per sample (the nearest shadow-map
-    // texel, whether a sample is still inside), and the two backends' shadow maps differ
-    // in float rounding, so a choice can flip at a pixel: measured 6.8 % at one pixel of
-    // random2 (under 1.1 % everywhere else), with the mean below 0.11 %.
-    EXPECT_LE(a.worstInterior, 0.08);
-    EXPECT_LE(double(a.edge), 0.01 * double(a.objectPixels));
-    EXPECT_LE(double(a.backgroundMismatches), 0.001 * double(a.objectPixels));
-    EXPECT_EQ(a.surfaceMismatches, 0u);
-  }
+  void expectAgreement(const Scene& scene) { test::expectGpuAgreement(scene, device()); }
 };
 
 /// The examples at a reduced image size (the comparison is per pixel; the light

@@ -67,29 +67,6 @@ fs::path temporaryFor(const fs::path& target) {
   return temp;
 }
 
-/// Removes "<target>.tmp-<pid>-<n>" left by a run that was killed (SIGKILL, power loss)
-/// before it could clean up: only when process <pid> no longer exists, so a concurrent
-/// run writing the same output keeps its temporary.
-void removeStaleTemporaries(const fs::path& target) {
-  fs::path dir = target.parent_path();
-  if (dir.empty()) dir = ".";
-  const std::string prefix = target.filename().string() + kTempMarker;
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    const std::string rest = name.substr(prefix.size());
-    const std::size_t dash = rest.find('-');
-    if (dash == 0 || dash == std::string::npos || dash > 9) continue;
-    if (rest.find_first_not_of("0123456789-") != std::string::npos) continue;
-    const pid_t pid = pid_t(std::stol(rest.substr(0, dash)));
-    if (pid <= 0 || pid == ::getpid()) continue;
-    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
-    std::error_code ignored;
-    fs::remove(it->path(), ignored);
-  }
-}
-
 }  // namespace
 
 void requireWritableOutput(const fs::path& target) {
@@ -103,6 +80,41 @@ void requireWritableOutput(const fs::path& target) {
     throw InputError(target.string() + ": output directory '" + dir.string() + "' is not writable");
   if (fs::is_directory(target, ec))
     throw InputError(target.string() + ": output path is a directory");
+}
+
+// Only when process <pid> no longer exists, so a concurrent run writing the same output
+// keeps its temporary. A writer that writes its temporary atomically in turn (the editor's
+// first save) leaves "<target>.tmp-<pid>-<n>.tmp-<pid>-<m>": removed when every pid named
+// is gone.
+void removeStaleTemporaries(const fs::path& target) {
+  fs::path dir = target.parent_path();
+  if (dir.empty()) dir = ".";
+  const std::string prefix = target.filename().string() + kTempMarker;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    bool stale = true;
+    std::string rest = name.substr(prefix.size());
+    while (stale) {
+      const std::size_t next = rest.find(kTempMarker);
+      const std::string part = rest.substr(0, next);
+      const std::size_t dash = part.find('-');
+      if (dash == 0 || dash == std::string::npos || dash > 9 || dash + 1 == part.size() ||
+          part.find_first_not_of("0123456789-") != std::string::npos || part.find('-', dash + 1) != std::string::npos) {
+        stale = false;
+        break;
+      }
+      const pid_t pid = pid_t(std::stol(part.substr(0, dash)));
+      // Alive, ours, or not ours to judge.
+      if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) stale = false;
+      if (next == std::string::npos) break;
+      rest = rest.substr(next + kTempMarker.size());
+    }
+    if (!stale) continue;
+    std::error_code ignored;
+    fs::remove(it->path(), ignored);
+  }
 }
 
 void writeAtomically(const fs::path& target, const std::function<void(const fs::path&)>& write) {

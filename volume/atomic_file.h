@@ -27,6 +27,12 @@ struct AtomicOutput {
 /// targets as they were rather than a new image beside a stale companion.
 void writeAtomicallyTogether(const std::vector<AtomicOutput>& outputs);
 
+/// Removes "<target>.tmp-<pid>-<n>" temporaries left beside `target` by a process that was
+/// killed (SIGKILL, power loss) while writing it, when process <pid> no longer exists.
+/// Every atomic write does this for its target; a program that may not write for a while
+/// (an editor opening a document) calls it at start, so the debris goes at once.
+void removeStaleTemporaries(const std::filesystem::path& target);
+
 /// Throws ResourceError "<target>: write failed: <strerror(error)>"; for writers whose
 /// stream failed (a full disk: "No space left on device").
 [[noreturn]] void throwWriteFailed(const std::filesystem::path& target, int error);
