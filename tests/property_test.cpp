@@ -161,7 +161,9 @@ TEST(Property, LatticeNeverReturnsMorePowerThanInjected) {
         ASSERT_LE(e.inGrid[ch], previous[ch] + given[ch] + tolerance)
             << replay(seed, r) << ": channel " << ch << " step " << step;
         ASSERT_GE(e.absorbed[ch], -tolerance) << replay(seed, r) << ": channel " << ch << " step " << step;
-        if (r.scene.lpv.scheme == LpvScheme::Seed) ASSERT_EQ(given[ch], 0.0) << replay(seed, r);
+        if (r.scene.lpv.scheme == LpvScheme::Seed) {
+          ASSERT_EQ(given[ch], 0.0) << replay(seed, r);
+        }
         if (injected[ch] > 0.0 && given[ch] / injected[ch] > worstOverdrain) {
           worstOverdrain = given[ch] / injected[ch];
           worstSeed = seed;
