@@ -5,7 +5,7 @@
 // lattice boundary or source that no longer follows the medium (with the extrapolation
 // length cut to 0.3 of the medium's this slab reads 0.63-0.67 of exact, and before the
 // calibration tied both to the medium a slab faded as the cells shrank: jade x0.59 at 64³).
-// Lower albedos and coarser cells are off by more, measured in the README, not asserted.
+// Lower albedos and coarser cells are off by more, measured in docs/accuracy.md, not asserted.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -4,7 +4,7 @@
 // the lattice's diffuse profile vanishes at the same extrapolation length beyond the true
 // surface. These tests render the same slab, lit and seen along its normal, aligned with
 // the grid and tilted, and compare the two SSLPV renders (the aligned one matches the path
-// tracer to 0.1 %, README "Calibration"). Light injected at the half-cell floor and read
+// tracer to 0.1 %, docs/accuracy.md). Light injected at the half-cell floor and read
 // back before it propagates is diluted over a staircase's cells; computeStepFactors also
 // corrects the exit gain for that (staircaseExitCorrection).
 #include <gtest/gtest.h>
