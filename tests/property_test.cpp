@@ -10,6 +10,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "monte_carlo.h"
 #include "random_scenes.h"
 #include "volume/cpu_renderer.h"
 #include "volume/lpv_calibration.h"
@@ -189,23 +190,6 @@ TEST(Property, LatticeNeverReturnsMorePowerThanInjected) {
 // there though each trial passes. `bias` is the float round-off of distances, 1e-5 of the
 // value.
 
-struct Estimate {
-  double mean = 0.0, standardError = 0.0;
-};
-
-template <typename F>
-Estimate estimate(int n, F&& sample) {
-  double sum = 0.0, sumSq = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double v = sample(i);
-    sum += v;
-    sumSq += v * v;
-  }
-  Estimate e;
-  e.mean = sum / n;
-  e.standardError = std::sqrt(std::max(0.0, (sumSq - n * e.mean * e.mean) / (n - 1.0)) / n);
-  return e;
-}
 
 class TrialCounter {
  public:
@@ -243,12 +227,7 @@ Scene slab(double d, const glm::dvec3& sigmaT, const glm::dvec3& sigmaS, double 
 /// global majorant, so the trackers go through null collisions instead of the exact
 /// homogeneous case.
 std::shared_ptr<const MaterialSet> distantDenseVoxel(double sigma) {
-  openvdb::initialize();
-  auto set = std::make_shared<MaterialSet>();
-  set->sigmaT = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaS = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaT->setName("sigma_t");
-  set->sigmaS->setName("sigma_s");
+  auto set = emptyMaterialSet();
   set->sigmaT->tree().setValueOn(openvdb::Coord(40, 40, 0), openvdb::Vec3s(float(sigma)));
   return set;
 }

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "monte_carlo.h"
 #include "volume/material_set.h"
 #include "volume/scene.h"
 
@@ -54,12 +55,7 @@ inline std::string vec3Json(double x, double y, double z) {
 
 /// Random σt/σs/g voxels (and sometimes a g grid) within `extent` of the rest-space origin.
 inline std::shared_ptr<const MaterialSet> randomMaterialSet(SceneRandom& r, double extent) {
-  openvdb::initialize();
-  auto set = std::make_shared<MaterialSet>();
-  set->sigmaT = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaS = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaT->setName("sigma_t");
-  set->sigmaS->setName("sigma_s");
+  auto set = emptyMaterialSet();
   const double voxel = extent / r.integer(3, 8);
   auto transform = openvdb::math::Transform::createLinearTransform(voxel);
   if (r.chance(0.5)) transform->postRotate(r.uniform(0.0, 3.0), openvdb::math::Y_AXIS);

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "monte_carlo.h"
 #include "test_support.h"
 #include "volume/image_io.h"
 #include "volume/majorant_grid.h"
@@ -53,12 +54,7 @@ Scene slabScene(double ior, double sigmaS = kSigmaS) {
 /// the base's, so the estimators along the axis go through null collisions: the answer
 /// there must still be the homogeneous one.
 std::shared_ptr<const MaterialSet> denseCornerSet() {
-  openvdb::initialize();
-  auto set = std::make_shared<MaterialSet>();
-  set->sigmaT = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaS = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaT->setName("sigma_t");
-  set->sigmaS->setName("sigma_s");
+  auto set = emptyMaterialSet();
   set->sigmaT->tree().setValueOn(openvdb::Coord(40, 40, 0), openvdb::Vec3s(5.0f));
   set->sigmaS->tree().setValueOn(openvdb::Coord(40, 40, 0), openvdb::Vec3s(1.0f));
   return set;
@@ -69,12 +65,7 @@ std::shared_ptr<const MaterialSet> denseCornerSet() {
 /// `voxel` rotated by 0.5 rad about y (so bricks and voxels never line up).
 std::shared_ptr<MaterialSet> randomBlobSet(int count, const openvdb::Coord& centre, int radius, double lo, double hi,
                                            double albedo, double voxel, std::uint64_t seed) {
-  openvdb::initialize();
-  auto set = std::make_shared<MaterialSet>();
-  set->sigmaT = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaS = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  set->sigmaT->setName("sigma_t");
-  set->sigmaS->setName("sigma_s");
+  auto set = emptyMaterialSet();
   auto transform = openvdb::math::Transform::createLinearTransform(voxel);
   transform->postRotate(0.5, openvdb::math::Y_AXIS);
   set->sigmaT->setTransform(transform);
@@ -112,24 +103,6 @@ double opticalDepth(const ReferenceTracer& tracer, const glm::dvec3& a, const gl
   return sum * (t1 - t0) * glm::length(d) / kSteps;
 }
 
-struct Estimate {
-  double mean = 0.0;
-  double standardError = 0.0;
-};
-
-template <typename F>
-Estimate estimate(int n, F&& sample) {
-  double sum = 0.0, sumSq = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double v = sample(i);
-    sum += v;
-    sumSq += v * v;
-  }
-  Estimate e;
-  e.mean = sum / n;
-  e.standardError = std::sqrt(std::max(0.0, (sumSq - n * e.mean * e.mean) / (n - 1.0)) / n);
-  return e;
-}
 
 void expectAgrees(const Estimate& e, double expected, double maxRelativeError, const char* what) {
   SCOPED_TRACE(what);
