@@ -36,6 +36,7 @@ struct Case {
 struct Options {
   int repeats = 7, warmup = 2;
   bool cpu = true, vulkan = true, quick = false, big = true;
+  bool coarseStart = true;  ///< --no-coarse-start: cold CPU frames start from the injected light
   std::string only;  ///< run only the cases of this sweep (empty: all)
 };
 
@@ -73,6 +74,7 @@ struct Row {
   double cameraOnly = 0;
   double nudge = 0;     ///< wall clock of a frame after a small light move (CPU: warm-started)
   int steps = 0, nudgeSteps = 0;
+  int coarseSteps = 0;  ///< steps on the coarser grids that started a cold CPU frame
   std::size_t activeCells = 0;
 };
 
@@ -106,6 +108,7 @@ Row measure(Renderer& renderer, const Scene& scene, const Options& o) {
     total.push_back(report.times.frame());
     wall.push_back(report.wallMs);
     row.steps = report.propagation.stepsRun;
+    row.coarseSteps = report.coarseStart.steps;
   }
   Camera cam = scene.camera;
   for (int i = 0; i < o.warmup + o.repeats; ++i) {
@@ -142,6 +145,8 @@ struct Roofline {
 };
 
 void printRow(const Case& c, const char* backend, const Row& r, const Roofline& roof = {}) {
+  char steps[32];
+  std::snprintf(steps, sizeof steps, r.coarseSteps > 0 ? "%d+%d" : "%d", r.steps, r.coarseSteps);
   const double mcells = r.propagate > 0 ? double(r.activeCells) * r.steps / (r.propagate * 1e3) : 0.0;
   char roofText[96] = "";
   if (roof.valid && r.propagate > 0) {
@@ -154,10 +159,10 @@ void printRow(const Case& c, const char* backend, const Row& r, const Roofline& 
     std::snprintf(roofText, sizeof roofText, " | %7.2f %6.2f %5.1f", gflops, gbs, 100.0 * gflops / attainable);
   }
   std::printf("%-9s %-7s %5d %5s %6d %9zu %2d | %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %5d | %9.2f %9.2f | "
-              "%8.2f %7d %9zu%s\n",
+              "%8.2f %7s %9zu%s\n",
               c.sweep.c_str(), backend, c.grid, c.steps ? std::to_string(c.steps).c_str() : "auto", c.shadowMap,
               c.triangles, c.lights, r.shadow, r.inject, r.propagate, r.shade, r.total, r.wall, r.cameraOnly, r.nudge,
-              r.nudgeSteps, r.voxelize, r.resample, mcells, r.steps, r.activeCells, roofText);
+              r.nudgeSteps, r.voxelize, r.resample, mcells, steps, r.activeCells, roofText);
   std::fflush(stdout);
 }
 
@@ -180,6 +185,7 @@ int main(int argc, char** argv) {
     } else if (a == "--quick") o.quick = true;
     else if (a == "--no-big") o.big = false;
     else if (a == "--only") o.only = next();
+    else if (a == "--no-coarse-start") o.coarseStart = false;
     else {
       std::fprintf(stderr, "frame_bench: unknown argument %s\n", a.c_str());
       return 2;
@@ -241,7 +247,10 @@ int main(int argc, char** argv) {
               "wall = whole frame as the caller sees it (propagation from scratch); camera = wall clock of a\n"
               "camera-only re-render; nudge, nsteps = wall clock and steps of a frame after a 0.5-unit light move\n"
               "(cpu --steps auto: propagation from the last frame's light);\n"
-              "voxelize/resample run once per mesh or material change (shown from the first frame)\n");
+              "voxelize/resample run once per mesh or material change (shown from the first frame);\n"
+              "steps (last column group) = fine+coarse: a cold cpu auto frame first solves the frame on coarser\n"
+              "grids (their steps after the +, their time inside propag; --no-coarse-start: off), Mcell/s counts\n"
+              "the fine steps only\n");
   Roofline roof;
   if (device) {
     std::printf("vulkan device: %s\n", device->name().c_str());
@@ -274,6 +283,7 @@ int main(int argc, char** argv) {
     try {
       if (o.cpu) {
         CpuRenderer cpu(scene);
+        cpu.setCoarseStart(o.coarseStart);
         printRow(shown, "cpu", measure(cpu, scene, o));
       }
       if (o.vulkan) {

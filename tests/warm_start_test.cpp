@@ -1,7 +1,8 @@
 // Warm-started propagation: after a material stroke or a light nudge, --steps auto starts
 // its semi-iteration from the previous frame's converged light. It must land as close to
 // the converged lattice as a cold start does, in fewer steps, and a renderer's
-// warm-started frame must match a fresh renderer's cold one.
+// warm-started frame must match a fresh renderer's cold one. A cold frame starts from the
+// same frame solved on a coarser grid (volume/coarse_start.h), under the same bounds.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 
 #include "lpv_test_grids.h"
 #include "test_support.h"
+#include "volume/coarse_start.h"
 #include "volume/cpu_renderer.h"
 #include "volume/image_metrics.h"
 #include "volume/material_set.h"
@@ -260,6 +262,102 @@ TEST(WarmStart, ARenderersWarmFramesMatchAFreshRenderersColdOnes) {
   renderer.render(scene.lpv, &reset);
   EXPECT_FALSE(reset.propagation.warmStarted);
   EXPECT_EQ(reset.propagation.stepsRun, full.propagation.stepsRun) << "the same cold run as the last frame's";
+}
+
+TEST(CoarseStart, ProlongingALinearLightIsExactInsideAndScalesByTheCellArea) {
+  // Trilinear interpolation reproduces a linear field wherever all 8 coarse cells are
+  // active; a cell's c0 is an intensity through a face of its size, so the fine grid's
+  // holds (1/2)² of the coarse one's for the same radiance.
+  MaterialGrid coarse = uniformMaterial(10, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f, 2.0);
+  MaterialGrid fine = uniformMaterial(20, glm::vec3(1.0f), glm::vec3(0.9f), 0.0f, 1.0);
+  const auto linear = [](const glm::dvec3& p, int ch) { return 3.0 + 0.5 * p.x - 0.25 * p.y + 0.125 * (ch + 1) * p.z; };
+  std::array<std::vector<float>, 3> light;
+  for (int ch = 0; ch < 3; ++ch) {
+    light[ch].assign(coarse.frame.cellCount(), 0.0f);
+    for (int z = 0; z < 10; ++z)
+      for (int y = 0; y < 10; ++y)
+        for (int x = 0; x < 10; ++x)
+          light[ch][coarse.frame.index(x, y, z)] = float(linear(coarse.frame.origin + 2.0 * (glm::dvec3(x, y, z) + 0.5), ch));
+  }
+  std::vector<unsigned char> active(fine.frame.cellCount());
+  for (std::size_t i = 0; i < active.size(); ++i) active[i] = fine.coverage[i] > 0.0f;
+  const auto fineLight = prolongLight(coarse, light, fine, active);
+  int checked = 0;
+  // Fine cells 3..16 have their centres between the centres of active coarse cells 1..8.
+  for (int z = 3; z <= 16; ++z)
+    for (int y = 3; y <= 16; ++y)
+      for (int x = 3; x <= 16; ++x)
+        for (int ch = 0; ch < 3; ++ch) {
+          const glm::dvec3 centre = fine.frame.origin + glm::dvec3(x, y, z) + 0.5;
+          EXPECT_NEAR(fineLight[ch][fine.frame.index(x, y, z)], 0.25 * linear(centre, ch), 1e-5) << x << "," << y << "," << z;
+          ++checked;
+        }
+  EXPECT_EQ(checked, 14 * 14 * 14 * 3);
+  EXPECT_EQ(fineLight[0][fine.frame.index(0, 5, 5)], 0.0f) << "an inactive fine cell holds no light";
+}
+
+TEST(CoarseStart, AColdFrameStartedFromCoarserGridsMatchesAFlatColdOneInFewerSteps) {
+  // Both runs stop by the same rule (the light still to come under autoTolerance of the
+  // whole), so their images may differ by the warm test's bound; and the coarse start
+  // must save fine-grid steps, or it buys nothing. At 32³ one coarser grid (16³) is
+  // solved, at 64³ two.
+  Scene scene = pebbleScene();
+  for (const int resolution : {32, 64}) {
+    scene.lpv.resolution = resolution;
+    CpuRenderer coarseStarted(scene), flat(scene);
+    flat.setCoarseStart(false);
+    RenderReport started, cold;
+    const Image startedImage = coarseStarted.render(scene.lpv, &started);
+    const Image coldImage = flat.render(scene.lpv, &cold);
+    const ImageDifference d = relativeDifference(startedImage, coldImage);
+    std::printf("%d³: flat cold %d steps; coarse-started %d steps + %d on %d coarser grid(s); image: mean %.2e, max %.2e\n",
+                resolution, cold.propagation.stepsRun, started.propagation.stepsRun, started.coarseStart.steps,
+                started.coarseStart.levels, d.mean, d.max);
+    EXPECT_EQ(started.coarseStart.levels, resolution == 32 ? 1 : 2);
+    EXPECT_TRUE(started.propagation.coarseStarted);
+    EXPECT_FALSE(started.propagation.warmStarted) << "a previous frame's light is another start";
+    EXPECT_FALSE(cold.propagation.coarseStarted);
+    EXPECT_EQ(cold.coarseStart.levels, 0);
+    EXPECT_LT(started.propagation.stepsRun, cold.propagation.stepsRun);
+    EXPECT_LT(d.mean, 4e-3);
+
+    // A light nudge then starts from the last frame, not from the coarse grids.
+    scene.lights[0].position += glm::dvec3(0.5, 0.0, 0.0);
+    coarseStarted.setLights(scene.lights);
+    RenderReport nudged;
+    coarseStarted.render(scene.lpv, &nudged);
+    EXPECT_TRUE(nudged.propagation.warmStarted);
+    EXPECT_EQ(nudged.coarseStart.levels, 0);
+    scene.lights[0].position -= glm::dvec3(0.5, 0.0, 0.0);
+  }
+}
+
+TEST(CoarseStart, AStrokeResamplesTheCoarseGridsAsAFreshRendererWould) {
+  // The coarse grids outlive frames; after a stroke they must hold the new material (a
+  // stale coarse grid would still converge, to the right light, so the image alone could
+  // hide it: the steps the coarse grids ran must equal a fresh renderer's too).
+  Scene scene = pebbleScene();
+  CpuRenderer renderer(scene);
+  renderer.render(scene.lpv);
+  const auto original = loadMaterialSet(*scene.material.vdb);
+  auto painted = std::make_shared<MaterialSet>(*original);
+  painted->sigmaS = openvdb::gridPtrCast<openvdb::Vec3SGrid>(original->sigmaS->deepCopyGrid());
+  auto s = painted->sigmaS->getAccessor();
+  const openvdb::CoordBBox block(openvdb::Coord(-4, 4, 8), openvdb::Coord(4, 12, 18));
+  for (auto ijk = block.begin(); ijk; ++ijk) s.setValue(*ijk, s.getValue(*ijk) * 0.2f);
+  Bounds everything;
+  everything.extend(glm::dvec3(-1e6));
+  everything.extend(glm::dvec3(1e6));
+  renderer.setMaterialSet(painted, everything);
+  RenderReport afterStroke, fresh;
+  const Image strokeImage = renderer.render(scene.lpv, &afterStroke);
+  CpuRenderer other(scene);
+  other.setMaterialSet(painted, std::nullopt);
+  const Image freshImage = other.render(scene.lpv, &fresh);
+  EXPECT_TRUE(afterStroke.propagation.coarseStarted);
+  EXPECT_EQ(afterStroke.coarseStart.steps, fresh.coarseStart.steps);
+  EXPECT_EQ(afterStroke.propagation.stepsRun, fresh.propagation.stepsRun);
+  EXPECT_LT(relativeDifference(strokeImage, freshImage).max, 1e-5);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "volume/cpu_renderer.h"
 
 #include "volume/lpv_calibration.h"
+#include "volume/coarse_start.h"
 
 #include <chrono>
 
@@ -57,6 +58,7 @@ void CpuRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, const s
   // by up to 5e-2, so only light changes reuse the last frame's light (108 -> 22 steps on
   // the pebble). propagate() itself supports warm strokes (warm_start_test).
   warm_.clear();
+  coarse_.materialChanged(touched);
 }
 
 Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
@@ -84,6 +86,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     material_.meanChord = meanChordLength(object_.mesh());
     // The twin of the GPU voxelizer, so both backends see the same occupancy.
     material_.coverage = voxelizeCoverageParity(object_.mesh(), material_.frame);
+    coarse_.geometryChanged();
     report.frame = material_.frame;
     report.times.voxelize = watch.lapMs();
   } else {
@@ -143,6 +146,10 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     options.autoSteps = settings.autoSteps;
     options.chebyshev = true;
     options.warmStart = &warm_;
+    report.coarseStart = CoarseStartReport{};
+    if (coarseStartEnabled_ && !warm_.holds(material_.frame))
+      coarse_.start(object_, material_, factors_, settings.resolution, scene_.material.ior, samples_, options, warm_,
+                    &report.coarseStart);
     report.propagation = propagate(material_, factors_, field, accumulated_, options);
     report.times.propagation = watch.lapMs();
   } else {

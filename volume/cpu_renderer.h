@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "volume/coarse_start.h"
 #include "volume/frame_report.h"
 #include "volume/image_io.h"
 #include "volume/lpv_stages.h"
@@ -41,6 +42,9 @@ class CpuRenderer {
   /// The next propagation starts cold, as the first frame's does, instead of from the
   /// last frame's converged light (benchmarks of whole frames, comparisons).
   void resetPropagation() { warm_.clear(); }
+  /// Whether a cold calibrated propagation starts from a solve on a coarser grid
+  /// (volume/coarse_start.h; on by default). Off, it starts from the injected light.
+  void setCoarseStart(bool enabled) { coarseStartEnabled_ = enabled; }
 
   const Scene& scene() const { return scene_; }
 
@@ -62,6 +66,8 @@ class CpuRenderer {
   /// change. Dropped where the problem is new: another grid, scheme or step setting, or
   /// a whole new material set (so a full frame is a cold one).
   PropagationWarmStart warm_;
+  CoarseStart coarse_;
+  bool coarseStartEnabled_ = true;
   RenderReport last_;
   Image image_;
 };

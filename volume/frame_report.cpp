@@ -46,6 +46,11 @@ std::string formatTimings(const RenderReport& r) {
                 r.backend.c_str(), r.frame.dims.x, r.frame.dims.y, r.frame.dims.z, r.frame.cellSize, r.activeCells,
                 r.propagation.stepsRun, r.triangles);
   out << line;
+  if (r.coarseStart.levels > 0) {
+    std::snprintf(line, sizeof line, "started from %d coarser grid%s: %d steps there, %.2f ms (in propagation)\n",
+                  r.coarseStart.levels, r.coarseStart.levels > 1 ? "s" : "", r.coarseStart.steps, r.coarseStart.ms);
+    out << line;
+  }
   if (r.propagation.capped)
     out << "warning: --steps auto stopped at its cap of " << r.propagation.stepsRun
         << " steps before converging: the light is not converged\n";

@@ -27,6 +27,13 @@ struct StageTimes {
   void markCached(Stage s) { cachedMask |= 1u << unsigned(s); }
 };
 
+/// What the coarse levels of one frame cost.
+struct CoarseStartReport {
+  int levels = 0;       ///< grids solved below the frame's own (0: no coarse start)
+  int steps = 0;        ///< propagation steps on all of them
+  double ms = 0.0;      ///< voxelize, resample, inject and propagate on all of them
+};
+
 struct RenderReport {
   StageTimes times;
   GridFrame frame;
@@ -41,6 +48,8 @@ struct RenderReport {
   std::vector<ShadowMapStats> lights;
   InjectionStats injection;
   PropagationResult propagation;
+  /// The coarse grids that started a cold propagation (CpuRenderer; volume/coarse_start.h).
+  CoarseStartReport coarseStart;
   /// StepFactors::opticalThickness of the last resampling (0: unknown or seed scheme).
   glm::dvec3 opticalThickness{0.0};
 };

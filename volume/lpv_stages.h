@@ -98,6 +98,9 @@ struct PropagationWarmStart {
   /// shading reads the light (half a cell, at most one cell, inside the surface, trilinear).
   /// Filled by the first warm run on the frame.
   std::vector<unsigned char> shell;
+  /// `light` is a coarser grid's prolonged (volume/coarse_start.h): the run rescales it
+  /// and probes the radius itself (`rho` is the coarser grid's, below this one's).
+  bool fromCoarserGrid = false;
   bool holds(const GridFrame& f) const {
     return !light[0].empty() && light[0].size() == f.cellCount() && frame.dims == f.dims &&
            frame.origin == f.origin && frame.cellSize == f.cellSize;
@@ -168,6 +171,8 @@ struct PropagationResult {
   bool capped = false;
   /// The Chebyshev run started from a previous frame's light (PropagationWarmStart).
   bool warmStarted = false;
+  /// The Chebyshev run started from a coarser grid's light (volume/coarse_start.h).
+  bool coarseStarted = false;
 };
 
 /// Per-cell transport factors of one step, derived from the material grid. Seed scheme:
