@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Quick start, step 1: install dependencies, build (Release) and render the default
-# example to build/example.png with a per-stage timing table (Vulkan backend; lavapipe
-# where there is no GPU).
+# example to build/example.png with a per-stage timing table (--backend auto: Vulkan on
+# a GPU, the CPU backend where Vulkan would run on the CPU through lavapipe).
 source "$(dirname "$0")/scripts/common.sh"
 sslpv_install_packages
 sslpv_build

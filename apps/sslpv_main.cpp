@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <utility>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <optional>
 #include <string>
@@ -109,7 +110,7 @@ void warnAboutScene(const sslpv::Scene& scene) {
 }
 
 struct RenderArgs {
-  std::string scene, output, backend = "vulkan", steps, scheme, size;
+  std::string scene, output, backend = "auto", steps, scheme, size;
   std::optional<int> grid, shadowMap;
   bool timings = false;
   float exposure = 1.0f;
@@ -118,8 +119,8 @@ struct RenderArgs {
 int runRender(const RenderArgs& args) {
   using namespace sslpv;
   const auto start = CliClock::now();
-  if (args.backend != "cpu" && args.backend != "vulkan")
-    throw InputError("--backend: unknown backend '" + args.backend + "' (vulkan, cpu)");
+  if (args.backend != "cpu" && args.backend != "vulkan" && args.backend != "auto")
+    throw InputError("--backend: unknown backend '" + args.backend + "' (auto, vulkan, cpu)");
   if (!isSupportedImageExtension(args.output))
     throw InputError(args.output + ": unsupported output format (use .png, .pfm or .exr)");
   requireWritableOutput(args.output);
@@ -141,30 +142,52 @@ int runRender(const RenderArgs& args) {
 
   RenderReport report;
   Image image;
-  if (args.backend == "cpu") {
-    image = CpuRenderer(scene).render(settings, &report);
-  } else {
+  std::string autoNote;
 #ifdef SSLPV_HAVE_VULKAN
+  std::unique_ptr<gpu::VulkanDevice> device;
+  if (args.backend != "cpu") {
     try {
-      gpu::VulkanDevice device;
-      image = gpu::VulkanRenderer(scene, device).render(settings, &report);
+      device = std::make_unique<gpu::VulkanDevice>();
     } catch (const GpuError& e) {
       // NoVulkanDeviceError included: the machine lacks what the GPU backend needs.
+      if (args.backend == "vulkan")
+        throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
+      autoNote = std::string("--backend auto: no usable Vulkan device (") + e.what() + "); the CPU backend rendered";
+    }
+    // Vulkan on the CPU (Mesa lavapipe) shares the CPU backend's cores with a slower
+    // code path: the CPU backend's frame is several times faster there (docs/performance.md).
+    if (device && args.backend == "auto" && device->properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {
+      autoNote = "--backend auto: " + device->name() +
+                 " is Vulkan on the CPU; the CPU backend is faster here (--backend vulkan to use it)";
+      device.reset();
+    }
+  }
+  if (device) {
+    try {
+      image = gpu::VulkanRenderer(scene, *device).render(settings, &report);
+    } catch (const GpuError& e) {
       throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
     }
-#else
-    throw ResourceError("--backend vulkan: this sslpv was built without Vulkan (--backend cpu needs no GPU)");
-#endif
+  } else {
+    image = CpuRenderer(scene).render(settings, &report);
   }
+#else
+  if (args.backend == "vulkan")
+    throw ResourceError("--backend vulkan: this sslpv was built without Vulkan (--backend cpu needs no GPU)");
+  image = CpuRenderer(scene).render(settings, &report);
+#endif
   warnIfOpticallyThin(report, args.scene);
   if (report.propagation.capped)
     std::cerr << "sslpv: warning: " << args.scene << ": --steps auto stopped at its cap of "
               << report.propagation.stepsRun << " steps before converging; the image may be off (fixed --steps N runs N)"
               << std::endl;
-  requireFiniteImage(image, args.scene, args.backend);
+  requireFiniteImage(image, args.scene, report.backend);
   warnIfBlack(image, args.scene);
   writeImage(image, args.output, args.exposure);
-  if (args.timings) std::cout << formatTimings(report);
+  if (args.timings) {
+    if (!autoNote.empty()) std::cout << autoNote << "\n";
+    std::cout << formatTimings(report);
+  }
   printWrote(args.output, imageSizeText(image), start);
   return 0;
 }
@@ -240,7 +263,9 @@ int main(int argc, char** argv) {
   renderCmd->add_option("-o,--output", render.output, "Output image (.png tone-mapped, .pfm/.exr linear)")
       ->required();
   renderCmd->add_option("--size", render.size, "Image size WxH, e.g. 640x480 (overrides camera.width/height)");
-  renderCmd->add_option("--backend", render.backend, "vulkan (default: Mesa lavapipe or a real GPU) or cpu");
+  renderCmd->add_option("--backend", render.backend,
+                        "auto (default: Vulkan on a GPU, the CPU backend where Vulkan would be Mesa lavapipe), "
+                        "vulkan or cpu");
   renderCmd->add_option("--grid", render.grid, "LPV cells along the longest axis (overrides lpv.resolution)");
   renderCmd->add_option("--steps", render.steps, "Propagation steps, or 'auto' (overrides lpv.steps)");
   renderCmd->add_option("--shadow-map", render.shadowMap, "Shadow-map texels per side (overrides lpv.shadow_map)");
