@@ -9,6 +9,7 @@
 #include "volume/material_set.h"
 #include "volume/mesh.h"
 #include "volume/ray_scene.h"
+#include "volume/shading_surface.h"
 #include "volume/single_scattering.h"
 #include "volume/voxelize_parity.h"
 
@@ -42,6 +43,7 @@ CpuRenderer::~CpuRenderer() = default;
 void CpuRenderer::setCamera(const Camera& camera) {
   scene_.camera = camera;
   dirty_.cameraChanged();
+  surface_.reset();
 }
 
 
@@ -87,6 +89,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
     // The twin of the GPU voxelizer, so both backends see the same occupancy.
     material_.coverage = voxelizeCoverageParity(object_.mesh(), material_.frame);
     coarse_.geometryChanged();
+    surface_.reset();
     report.frame = material_.frame;
     report.times.voxelize = watch.lapMs();
   } else {
@@ -158,8 +161,13 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::Shading)) {
     const bool calibrated = factors_.scheme == LpvScheme::Calibrated;
-    image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
-                        &factors_.reducedAlbedo, calibrated ? &entries_ : nullptr);
+    // The camera rays and the cells each pixel reads depend on the camera and the
+    // geometry only: a light move or a stroke re-shades without casting them again.
+    if (!surface_)
+      surface_ = std::make_unique<ShadingSurface>(
+          traceShadingSurface(scene_.camera, *rays_, material_, scene_.material.ior));
+    image_ = shadeSurface(*surface_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
+                          &factors_.reducedAlbedo, calibrated ? &entries_ : nullptr);
     report.times.shading = watch.lapMs();
   } else {
     report.times.markCached(Stage::Shading);

@@ -16,6 +16,8 @@
 
 namespace sslpv {
 
+struct ShadingSurface;
+
 class RayScene;
 
 class CpuRenderer {
@@ -67,6 +69,7 @@ class CpuRenderer {
   /// a whole new material set (so a full frame is a cold one).
   PropagationWarmStart warm_;
   CoarseStart coarse_;
+  std::unique_ptr<ShadingSurface> surface_;  ///< null: the camera or the geometry changed
   bool coarseStartEnabled_ = true;
   RenderReport last_;
   Image image_;

@@ -18,12 +18,10 @@ struct ReducedMedium {
   glm::dvec3 scattering{0.0};  ///< σs' per channel
 };
 
-/// σt' and σs' at q with the shading's coverage-weighted trilinear weights; false where no
-/// active cell is near (q has left the object).
-bool reducedMediumAt(const MaterialGrid& material, const glm::dvec3& q, ReducedMedium& out) {
-  std::size_t cells[8];
-  float weights[8];
-  const int used = activeTrilinearWeights(material, q, cells, weights);
+/// σt' and σs' over the cells and weights of activeTrilinearWeights; false for none (the
+/// point has left the object).
+bool reducedMedium(const MaterialGrid& material, const std::size_t* cells, const float* weights, int used,
+                   ReducedMedium& out) {
   if (used == 0) return false;
   out = ReducedMedium{};
   for (int i = 0; i < used; ++i) {
@@ -93,25 +91,73 @@ double singleScatteringIntegral(double sigma, double p0, double k, double end) {
   return total;
 }
 
-double viewRayExit(const MaterialGrid& material, const glm::dvec3& p, const glm::dvec3& into, double extinction) {
+namespace {
+
+int longestSide(const GridFrame& frame) { return std::max({frame.dims.x, frame.dims.y, frame.dims.z}); }
+
+/// How deep singleScatteringGeometry searches for the exit: the steps of a medium of 1.5
+/// optical depths per cell, so that in denser ones the search is all cached, and a clearer
+/// one searches on from there.
+constexpr int kCachedExitSteps = int(SSLPV_SINGLE_SCATTERING_EXIT_DEPTH / 1.5) + 1;
+
+/// The first step i in [first, last] along `into` whose cell is not active; 0 for none.
+int firstInactiveStep(const MaterialGrid& material, const glm::dvec3& p, const glm::dvec3& into, int first, int last) {
   const GridFrame& frame = material.frame;
-  // An optically thin object is crossed whole: its light comes from all of it.
-  const int across = std::max({frame.dims.x, frame.dims.y, frame.dims.z});
-  const int steps = int(std::min<double>(across, std::ceil(SSLPV_SINGLE_SCATTERING_EXIT_DEPTH / (extinction * frame.cellSize))));
-  for (int i = 1; i <= steps; ++i) {
+  for (int i = first; i <= last; ++i) {
     const glm::dvec3 g = frame.toGrid(p + (i * frame.cellSize) * into);
     const glm::ivec3 c(int(std::floor(g.x)), int(std::floor(g.y)), int(std::floor(g.z)));
-    if (!frame.contains(c.x, c.y, c.z) || !isActiveCell(material, c.x, c.y, c.z)) return (i - 0.5) * frame.cellSize;
+    if (!frame.contains(c.x, c.y, c.z) || !isActiveCell(material, c.x, c.y, c.z)) return i;
   }
-  return std::numeric_limits<double>::infinity();
+  return 0;
+}
+
+/// Where viewRayExit searches to: SSLPV_SINGLE_SCATTERING_EXIT_DEPTH optical depths of
+/// `extinction`, at most across the grid (an optically thin object is crossed whole: its
+/// light comes from all of it).
+int exitSearchSteps(const GridFrame& frame, double extinction) {
+  return int(std::min<double>(longestSide(frame), std::ceil(SSLPV_SINGLE_SCATTERING_EXIT_DEPTH / (extinction * frame.cellSize))));
+}
+
+/// viewRayExit with the first `searched` steps' answer known (`exitStep`, 0: none there).
+double exitAfter(const MaterialGrid& material, const glm::dvec3& p, const glm::dvec3& into, double extinction,
+                 int exitStep, int searched) {
+  const int steps = exitSearchSteps(material.frame, extinction);
+  if (exitStep == 0 && steps > searched) exitStep = firstInactiveStep(material, p, into, searched + 1, steps);
+  return exitStep > 0 && exitStep <= steps ? (exitStep - 0.5) * material.frame.cellSize
+                                           : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+double viewRayExit(const MaterialGrid& material, const glm::dvec3& p, const glm::dvec3& into, double extinction) {
+  return exitAfter(material, p, into, extinction, 0, 0);
+}
+
+SingleScatteringGeometry singleScatteringGeometry(const MaterialGrid& material, const glm::dvec3& p,
+                                                  const glm::dvec3& inward, const glm::dvec3& into) {
+  SingleScatteringGeometry geometry;
+  geometry.used = activeTrilinearWeights(material, p + 0.5 * material.frame.cellSize * inward, geometry.cells.data(),
+                                         geometry.weights.data());
+  if (geometry.used > 0) {
+    geometry.exitSearched = std::min(kCachedExitSteps, longestSide(material.frame));
+    geometry.exitStep = firstInactiveStep(material, p, into, 1, geometry.exitSearched);
+  }
+  return geometry;
 }
 
 glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
                                   const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into) {
+  return singleScatteredRadiance(material, maps, p, inward, into, singleScatteringGeometry(material, p, inward, into));
+}
+
+glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
+                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into,
+                                  const SingleScatteringGeometry& geometry) {
   const double cellSize = material.frame.cellSize;
   glm::dvec3 q = p + 0.5 * cellSize * inward;
   ReducedMedium medium;
-  if (!reducedMediumAt(material, q, medium)) return glm::vec3(0.0f);
+  if (!reducedMedium(material, geometry.cells.data(), geometry.weights.data(), geometry.used, medium))
+    return glm::vec3(0.0f);
   // Where the view ray leaves the object, searched as deep as the most transparent
   // channel's light can come from.
   double clearest = std::numeric_limits<double>::infinity(), densest = 0.0;
@@ -121,7 +167,7 @@ glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vecto
       densest = std::max(densest, medium.extinction[ch]);
     }
   if (clearest == std::numeric_limits<double>::infinity()) return glm::vec3(0.0f);
-  const double exit = viewRayExit(material, p, into, clearest);
+  const double exit = exitAfter(material, p, into, clearest, geometry.exitStep, geometry.exitSearched);
   // Where the whole chord is under a mean free path, its light comes from all along it,
   // not from below the surface: the entry is read at the chord's middle (a point just
   // under the surface may lie past the terminator of a light that lights the inside).

@@ -9,6 +9,8 @@
 // below a planar entry face, so the integral has a closed form; the camera sees T(θo)/η²
 // of it. Derivation, the cut past a terminator and what the closed form gives up:
 // docs/design.md §6.8 "Single scattering" and §6.7.8.
+#include <array>
+#include <cstddef>
 #include <glm/vec3.hpp>
 #include <limits>
 #include <vector>
@@ -51,6 +53,22 @@ double singleScatteringIntegral(double sigma, double p0, double k,
 /// leave within them. Within half a cell of the true exit.
 double viewRayExit(const MaterialGrid& material, const glm::dvec3& p, const glm::dvec3& into, double extinction);
 
+/// What the term reads of the grid's occupancy at one surface point, which only the
+/// geometry (mesh, grid, camera) decides: a renderer keeps it while lights and strokes
+/// change the rest.
+struct SingleScatteringGeometry {
+  /// The medium's trilinear cells and weights half a cell inside p (`used` 0: none).
+  std::array<std::size_t, 8> cells{};
+  std::array<float, 8> weights{};
+  int used = 0;
+  /// The first whole-cell step along `into` whose cell is not active among the first
+  /// `exitSearched` (0: none there; viewRayExit searches on where the medium is clear).
+  int exitStep = 0;
+  int exitSearched = 0;
+};
+SingleScatteringGeometry singleScatteringGeometry(const MaterialGrid& material, const glm::dvec3& p,
+                                                  const glm::dvec3& inward, const glm::dvec3& into);
+
 /// L(p, −t) above, per channel, inside the boundary: `into` is the refracted view
 /// direction (unit, into the medium), `inward` the inward unit normal at p. The medium and
 /// each light's entry are read half a cell inside p (where the shading's exit law reads
@@ -59,5 +77,9 @@ double viewRayExit(const MaterialGrid& material, const glm::dvec3& p, const glm:
 /// lit from behind.
 glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
                                   const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into);
+/// The same with the point's geometry already known (bit for bit the same result).
+glm::vec3 singleScatteredRadiance(const MaterialGrid& material, const std::vector<EntryMap>& maps,
+                                  const glm::dvec3& p, const glm::dvec3& inward, const glm::dvec3& into,
+                                  const SingleScatteringGeometry& geometry);
 
 }  // namespace sslpv
