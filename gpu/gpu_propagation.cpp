@@ -371,22 +371,25 @@ void GpuPropagator::recordSteps(VkCommandBuffer cmd, Mode mode, int firstStep, i
     // Every other step accumulates its sources and results. From the host, the injected
     // light (step 0's sources) is already in, so odd steps do; on the device, step 0
     // starts the accumulated grid with both, then even steps add.
-    if (mode == Mode::Host) push.accumulate = step % 2 == 1 ? 1 : 0;
-    if (mode == Mode::Device) push.accumulate = step == 0 ? 2 : step % 2 == 0 ? 1 : 0;
+    if (mode == Mode::Host) push.accumulate = step % 2 == 1 ? SSLPV_ACCUMULATE_ADD : SSLPV_ACCUMULATE_NONE;
+    if (mode == Mode::Device)
+      push.accumulate = step == 0 ? SSLPV_ACCUMULATE_START_FRESH : step % 2 == 0 ? SSLPV_ACCUMULATE_ADD : SSLPV_ACCUMULATE_NONE;
     if (chebyshev) {
       // Step 0 leaves its light alone in the accumulated grid (y) and makes no stop
       // decision; then the probe steps and the iterates, which accumulate nothing
       // (runChebyshev on the CPU).
       push.autoSteps = step == 0 ? 0 : 1;
-      push.chebyshev = step == 0 ? 0 : step <= SSLPV_CHEBYSHEV_PROBE_STEPS ? 1 : 2;
-      push.accumulate = step == 0 ? 3 : 0;
+      push.chebyshev = step == 0                              ? SSLPV_CHEBYSHEV_NONE
+                       : step <= SSLPV_CHEBYSHEV_PROBE_STEPS ? SSLPV_CHEBYSHEV_PROBE
+                                                             : SSLPV_CHEBYSHEV_ITERATE;
+      push.accumulate = step == 0 ? SSLPV_ACCUMULATE_START_RESULT : SSLPV_ACCUMULATE_NONE;
     }
     // Step 0 reads the injected light, which may hold a linear band; after it, factors
     // that keep cells isotropic have left none.
     const StepKernel kernel = step == 0 || !isotropicSteps_ ? StepKernel::General
                               : chebyshev                   ? StepKernel::Chebyshev
                                                             : StepKernel::Isotropic;
-    stepPipeline(kernel, push.accumulate != 0).bind(cmd, sets_[step % 2], &push, sizeof(push));
+    stepPipeline(kernel, push.accumulate != SSLPV_ACCUMULATE_NONE).bind(cmd, sets_[step % 2], &push, sizeof(push));
     if (groups > 0) vkCmdDispatch(cmd, groups, 1, 1);
     computeToComputeBarrier(cmd);
     if (timestamps) timestamps_.write(cmd, 1 + 2 * std::uint32_t(s));
@@ -417,7 +420,7 @@ bool GpuPropagator::chebyshevRun(Mode mode, const PropagationOptions& options) c
 void GpuPropagator::recordFinish(VkCommandBuffer cmd, Mode mode, int stepLimit, const PropagationOptions& options) {
   if (itemCount_ == 0) return;
   LpvStepPush push = stepPush(options);
-  push.chebyshev = chebyshevRun(mode, options) ? 1 : 0;
+  push.chebyshev = chebyshevRun(mode, options) ? SSLPV_CHEBYSHEV_ITERATE : SSLPV_CHEBYSHEV_NONE;
   // The last step is missing from the accumulated grid when it did not accumulate: from
   // the host odd steps accumulate, so the last one (index stepsRun - 1) is missing when
   // stepsRun is odd and its light is in tiled_[1]; on the device even steps do, so it is

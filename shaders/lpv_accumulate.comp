@@ -26,7 +26,7 @@ void main() {
                                               : vec3(0.0);
   const vec3 lastScale = tailScale + (addLast ? 1.0 : 0.0);
   const bool addTail = any(notEqual(tailScale, vec3(0.0)));
-  const int runs = finished && (OUTPUT == 1 || addLast || addTail || push.chebyshev != 0) ? 1 : 0;
+  const int runs = finished && (OUTPUT == 1 || addLast || addTail || push.chebyshev != SSLPV_CHEBYSHEV_NONE) ? 1 : 0;
   for (int once = 0; once < runs; ++once)  // a loop, not an if: lavapipe never skips an if
     for (int z = int(item.z); z < int(item.w); ++z)
       [[unroll]] for (int r = 0; r < ROWS; ++r) {
@@ -39,7 +39,7 @@ void main() {
           // otherwise the last step wrote the set's other field. Ring cells hold no light
           // in either grid.
           vec4 total;
-          if (push.chebyshev != 0) {
+          if (push.chebyshev != SSLPV_CHEBYSHEV_NONE) {
             // The last iterate (written by step stepsRun - 1 into the set's source field
             // when stepsRun is even) plus the injected light times its fresh gain.
             const vec4 iterate = stepsRun % 2 == 0 ? texelFetch(sourceField, 3 * i + ch) : texelFetch(otherField, 3 * i + ch);

@@ -31,9 +31,9 @@
 
 layout(local_size_x = SSLPV_TILE_X) in;
 // ROWS (lpv_step_common.glsl): registers per invocation grow with it.
-/// 1: this step accumulates (push.accumulate 1: accumulated += source + result; 2:
-/// accumulated = source + result, the first step of a device-resident run, which needs
-/// no cleared buffer). 0: it does not.
+/// 1: this step accumulates (push.accumulate one of the SSLPV_ACCUMULATE_* other than
+/// NONE; the START modes overwrite, so the first step of a device-resident run needs no
+/// cleared buffer). 0: it does not.
 layout(constant_id = 1) const int ACCUMULATE = 0;
 /// 1: the source field has no linear band and the step factors keep it so (the calibrated
 /// scheme after its first step): emitIsotropicChannel instead of the clamped faces.
@@ -115,8 +115,8 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
   const float on = dc.w;
   vec4 value[3];
   if (CHEBYSHEV != 0) {
-    // Probe steps (push.chebyshev 1) are plain linear steps: weight 1, no source.
-    const bool probe = push.chebyshev == 1;
+    // Probe steps are plain linear steps: weight 1, no source.
+    const bool probe = push.chebyshev == SSLPV_CHEBYSHEV_PROBE;
     const vec3 omega = probe ? vec3(1.0) : vec3(control.omegaR, control.omegaG, control.omegaB);
     for (int ch = 0; ch < 3; ++ch) {
       const float older = texelFetch(otherField, 3 * i + ch).x;
@@ -140,14 +140,15 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
   if (ACCUMULATE != 0) {
     // Overwriting multiplies the old value by 0: the buffer is cleared once at setup, so
     // it never holds a NaN.
-    const float keep = push.accumulate == 1 ? 1.0 : 0.0;
+    const float keep = push.accumulate == SSLPV_ACCUMULATE_ADD ? 1.0 : 0.0;
     // Step 0 of a device-resident run: its source is the injected light, which enters the
     // accumulated light times the fresh gain (addInjected on the CPU). Before Chebyshev
-    // iterates (3) the accumulated light holds this step's alone, their y; the finish
-    // adds the injected light.
-    const vec3 sourceGain = push.accumulate == 2   ? texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 3).xyz
-                            : push.accumulate == 3 ? vec3(0.0)
-                                                   : vec3(1.0);
+    // iterates the accumulated light holds this step's alone, their y; the finish adds
+    // the injected light.
+    const vec3 sourceGain = push.accumulate == SSLPV_ACCUMULATE_START_FRESH
+                                ? texelFetch(factors, SSLPV_FACTOR_VEC4_PER_CELL * i + 3).xyz
+                            : push.accumulate == SSLPV_ACCUMULATE_START_RESULT ? vec3(0.0)
+                                                                               : vec3(1.0);
     for (int ch = 0; ch < 3; ++ch)
       accumulated[3 * i + ch] =
           keep * texelFetch(accumulatedIn, 3 * i + ch) + sourceGain[ch] * texelFetch(sourceField, 3 * i + ch) + value[ch];

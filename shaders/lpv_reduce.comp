@@ -51,13 +51,13 @@ void main() {
     totals[SSLPV_ENERGY_VEC4S * push.stepSlot + k] = row[k];
   }
 
-  if (push.chebyshev != 0) {
+  if (push.chebyshev != SSLPV_CHEBYSHEV_NONE) {
     // runChebyshev() on the CPU.
     control.stepsRun += 1;
     const vec3 change = vec3(row[1].zw, row[2].x);                     // SSLPV_ENERGY_GATHERED
     const vec3 total = row[3].xyz * float(SSLPV_FLUX_PER_C0);          // SSLPV_ENERGY_IN_GRID
     vec3 rho = vec3(control.rhoR, control.rhoG, control.rhoB);
-    if (push.chebyshev == 1) {
+    if (push.chebyshev == SSLPV_CHEBYSHEV_PROBE) {
       // A probe step: the ratio of its power to the last one's estimates the radius.
       const vec3 previous = vec3(control.previousInGridR, control.previousInGridG, control.previousInGridB);
       for (int ch = 0; ch < 3; ++ch)

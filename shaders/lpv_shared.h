@@ -42,6 +42,17 @@ namespace sslpv::gpu {
 /// (StepFactors).
 #define SSLPV_FACTOR_VEC4_PER_CELL 5
 
+/// LpvStepPush::accumulate: what a step does with the accumulated grid.
+#define SSLPV_ACCUMULATE_NONE 0          /* leaves it */
+#define SSLPV_ACCUMULATE_ADD 1           /* accumulated += source + result */
+#define SSLPV_ACCUMULATE_START_FRESH 2   /* accumulated = freshGain source + result (a device run's step 0) */
+#define SSLPV_ACCUMULATE_START_RESULT 3  /* accumulated = result (step 0 before Chebyshev iterates: their y) */
+
+/// LpvStepPush::chebyshev: the step's part in a Chebyshev semi-iteration.
+#define SSLPV_CHEBYSHEV_NONE 0     /* plain steps */
+#define SSLPV_CHEBYSHEV_PROBE 1    /* a plain linear step whose power ratio estimates the radius */
+#define SSLPV_CHEBYSHEV_ITERATE 2  /* an iterate (for the accumulation: any Chebyshev run) */
+
 /// Push constants of the propagation step, the per-step reduction and the accumulation.
 #define SSLPV_LPV_STEP_PUSH_FIELDS(X)                                                       \
   X(int, dimsX)          /* grid cells per axis */                                        \
@@ -52,11 +63,11 @@ namespace sslpv::gpu {
   X(int, autoSteps)      /* 1: stop once a step adds < tolerance of accumulated power */  \
   X(float, autoTolerance)                                                                  \
   X(int, initPower)      /* 1: this step's source power starts the accumulated power */   \
-  X(int, accumulate)     /* 0: no; 1: accumulated += source + result; 2: = freshGain source + result; 3: = result */ \
+  X(int, accumulate)     /* SSLPV_ACCUMULATE_* */                                          \
   X(int, leftoverParity) /* the accumulation kernel adds the last field if stepsRun % 2 is this */ \
   X(int, stepLimit)      /* ... once stepsRun reaches this or auto steps stopped */       \
   X(float, autoTailTolerance) /* and the estimated power still to come is below this */ \
-  X(int, chebyshev)      /* PropagationOptions::chebyshev: 1 a probe step, 2 an iterate */
+  X(int, chebyshev)      /* SSLPV_CHEBYSHEV_* */
 
 struct LpvStepPush {
   SSLPV_LPV_STEP_PUSH_FIELDS(SSLPV_DECLARE_FIELD)
