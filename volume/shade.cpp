@@ -42,7 +42,11 @@ ShadingSurface traceShadingSurface(const Camera& camera, const RayScene& rays, c
   tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
     std::vector<glm::vec3> origins(camera.width), dirs(camera.width);
     std::vector<RayHit> hits(camera.width);
+    // A row's pixels gather here first, so that each row's list is allocated once, exactly.
+    std::vector<ShadingSurface::Pixel> row;
+    row.reserve(std::size_t(camera.width));
     for (int y = rows.begin(); y < rows.end(); ++y) {
+      row.clear();
       for (int x = 0; x < camera.width; ++x) {
         const double u = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalfX;
         const double v = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalfY;
@@ -50,7 +54,6 @@ ShadingSurface traceShadingSurface(const Camera& camera, const RayScene& rays, c
         dirs[x] = glm::vec3(glm::normalize(forward + u * right + v * up));
       }
       rays.intersectMany(origins.data(), dirs.data(), hits.data(), std::size_t(camera.width));
-      std::vector<ShadingSurface::Pixel>& found = rowsFound[std::size_t(y)];
       for (int x = 0; x < camera.width; ++x) {
         const RayHit& hit = hits[x];
         if (!hit.hit) continue;
@@ -71,8 +74,9 @@ ShadingSurface traceShadingSurface(const Camera& camera, const RayScene& rays, c
         pixel.refracts = entersMedium(cosOut, ior);
         if (pixel.refracts)
           pixel.single = singleScatteringGeometry(material, p, -n, refractInto(glm::dvec3(dirs[x]), n, ior));
-        found.push_back(pixel);
+        row.push_back(pixel);
       }
+      rowsFound[std::size_t(y)].assign(row.begin(), row.end());
     }
   });
   std::size_t count = 0;
