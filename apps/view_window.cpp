@@ -158,6 +158,7 @@ class Viewer {
   void cursor(double x, double y);
   void scroll(double steps);
   void key(ViewKey key, bool pressed);
+  void redraw() { redraw_ = true; }
 
  private:
   enum class Drag { None, Camera, Light };
@@ -209,6 +210,7 @@ class Viewer {
   int rendered_ = 0;
   StageTimes stageSum_;
   double wallSum_ = 0.0;
+  double presentMs_ = 0.0;  ///< overlay, copy into the swapchain and present, all frames
   int stepsLast_ = 0;
 };
 
@@ -262,7 +264,8 @@ void Viewer::collectResults() {
   for (RenderResult& result : worker_.take()) {
     finished_ = std::max(finished_, result.id);
     if (!result.error.empty()) {
-      if (!frame_) throw InputError(result.error);  // nothing was ever shown: nothing to keep
+      if (!frame_ && result.resourceError) throw ResourceError(result.error);  // nothing shown: nothing to keep
+      if (!frame_) throw InputError(result.error);
       if (result.scene != shownScene_) ++reloadFailures_;
       printWarning("view: " + result.error + " (the window keeps the last good frame)");
       continue;
@@ -304,7 +307,8 @@ std::vector<std::string> Viewer::statusLines() const {
 }
 
 double Viewer::fps() const {
-  if (newFrames_.size() < 2) return 0.0;
+  // Idle for a second: no frames are being made, whatever the last burst's rate was.
+  if (newFrames_.size() < 2 || Clock::now() - newFrames_.back() > std::chrono::seconds(1)) return 0.0;
   const double seconds = std::chrono::duration<double>(newFrames_.back() - newFrames_.front()).count();
   return seconds > 0.0 ? double(newFrames_.size() - 1) / seconds : 0.0;
 }
@@ -322,9 +326,11 @@ void Viewer::updateTitle() {
 
 void Viewer::present() {
   if (!frame_) return;
+  const Clock::time_point begin = Clock::now();
   gpu::DisplayFrame shown{frame_->width, frame_->height, frame_->rgb};
   if (overlay_) drawOverlay(shown.rgb, shown.width, shown.height, statusLines());
   const bool presented = presenter_.present(shown, width_, height_, framesMode() ? &lastPresented_ : nullptr);
+  presentMs_ += std::chrono::duration<double, std::milli>(Clock::now() - begin).count();
   redraw_ = false;
   if (!presented) return;
   const Clock::time_point now = Clock::now();
@@ -431,12 +437,12 @@ void Viewer::printSummary() const {
   std::snprintf(text, sizeof text,
                 "view: %d frames presented (%d rendered) at %dx%d, %s, %s: %.2f frames/s after the first; "
                 "per rendered frame after the first: %.1f ms (shadow %.2f, inject %.2f, propagate %.2f, shade "
-                "%.2f ms)\n",
+                "%.2f ms); presenting: %.1f ms per frame\n",
                 presented_, rendered_, width_, height_, frame_ ? frame_->report.backend.c_str() : "no frame",
                 controls_.settingsText().c_str(), seconds > 0.0 ? (presented_ - 1) / seconds : 0.0,
                 later > 0 ? wallSum_ / later : 0.0, later > 0 ? stageSum_.shadowMap / later : 0.0,
                 later > 0 ? stageSum_.injection / later : 0.0, later > 0 ? stageSum_.propagation / later : 0.0,
-                later > 0 ? stageSum_.shading / later : 0.0);
+                later > 0 ? stageSum_.shading / later : 0.0, presented_ > 0 ? presentMs_ / presented_ : 0.0);
   std::cout << text << std::flush;
 }
 
@@ -502,6 +508,8 @@ void installCallbacks(GLFWwindow* window, Viewer* viewer) {
     glfwGetCursorPos(w, &x, &y);
     viewerOf(w)->mouseButton(button == GLFW_MOUSE_BUTTON_RIGHT, action == GLFW_PRESS, x, y);
   });
+  // Exposed again after being covered: without a compositor the window must repaint.
+  glfwSetWindowRefreshCallback(window, [](GLFWwindow* w) { viewerOf(w)->redraw(); });
   glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) { viewerOf(w)->cursor(x, y); });
   glfwSetScrollCallback(window, [](GLFWwindow* w, double /*dx*/, double dy) { viewerOf(w)->scroll(dy); });
   glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int /*scancode*/, int action, int /*mods*/) {

@@ -3,6 +3,8 @@
 #include <new>
 #include <utility>
 
+#include "volume/error.h"
+
 namespace sslpv {
 
 namespace {
@@ -103,6 +105,7 @@ RenderResult RenderWorker::renderOne(std::uint64_t id, const RenderRequest& requ
         failedScene_ = request.scene;
         result.scene = request.scene;
         result.error = oneLine(e.what());
+        result.resourceError = dynamic_cast<const ResourceError*>(&e) != nullptr;
         return result;
       }
     }
@@ -125,6 +128,10 @@ RenderResult RenderWorker::renderOne(std::uint64_t id, const RenderRequest& requ
     result.rgb = toDisplayRgb8(image, request.exposure);
   } catch (const std::bad_alloc&) {
     result.error = "out of memory rendering the frame (try a smaller --grid or window)";
+    result.resourceError = true;
+  } catch (const ResourceError& e) {
+    result.error = oneLine(e.what());
+    result.resourceError = true;
   } catch (const std::exception& e) {
     result.error = oneLine(e.what());
   }

@@ -53,6 +53,7 @@ struct RenderResult {
   /// Why there is no frame: the request's scene could not be loaded (the last good
   /// backend stays in use) or the render failed. One line.
   std::string error;
+  bool resourceError = false;  ///< the machine lacks what the backend needs (not the scene's fault)
 };
 
 class RenderWorker {
