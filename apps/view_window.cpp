@@ -146,6 +146,9 @@ class Viewer {
         controls_(setup.scene, setup.settings),
         overlay_(!args.noOverlay) {
     controls_.setAnimated(sceneIsAnimated(setup.scene));
+    keepPresented_ = framesMode() || std::any_of(script_.begin(), script_.end(), [](const ScriptEvent& e) {
+                       return e.kind == ScriptEvent::Kind::Screenshot;
+                     });
     baseScene_ = std::make_shared<const Scene>(std::move(setup.scene));
     scene_ = baseScene_;
     watchFiles();
@@ -207,6 +210,7 @@ class Viewer {
   int presented_ = 0;
   Clock::time_point firstPresent_{}, lastPresent_{};
   gpu::DisplayFrame lastPresented_;
+  bool keepPresented_ = false;  ///< read each presented frame back (screenshots need it)
   int rendered_ = 0;
   StageTimes stageSum_;
   double wallSum_ = 0.0;
@@ -327,18 +331,18 @@ void Viewer::updateTitle() {
 void Viewer::present() {
   if (!frame_) return;
   const Clock::time_point begin = Clock::now();
+  if (newFrame_) {  // counted before the overlay is drawn, so it includes this frame
+    newFrames_.push_back(begin);
+    while (newFrames_.size() > 2 && begin - newFrames_.front() > std::chrono::seconds(1)) newFrames_.pop_front();
+    newFrame_ = false;
+  }
   gpu::DisplayFrame shown{frame_->width, frame_->height, frame_->rgb};
   if (overlay_) drawOverlay(shown.rgb, shown.width, shown.height, statusLines());
-  const bool presented = presenter_.present(shown, width_, height_, framesMode() ? &lastPresented_ : nullptr);
+  const bool presented = presenter_.present(shown, width_, height_, keepPresented_ ? &lastPresented_ : nullptr);
   presentMs_ += std::chrono::duration<double, std::milli>(Clock::now() - begin).count();
   redraw_ = false;
   if (!presented) return;
   const Clock::time_point now = Clock::now();
-  if (newFrame_) {
-    newFrames_.push_back(now);
-    while (newFrames_.size() > 2 && now - newFrames_.front() > std::chrono::seconds(1)) newFrames_.pop_front();
-    newFrame_ = false;
-  }
   if (presented_ == 0) firstPresent_ = now;
   lastPresent_ = now;
   ++presented_;
@@ -452,12 +456,13 @@ int Viewer::run() {
   Clock::time_point last = Clock::now();
   std::size_t next = 0;
   while (!quit_) {
+    // Scripts run in the interactive loop too (frames count presents there as well).
+    while (next < script_.size() && script_[next].frame <= presented_) applyScript(script_[next++]);
     if (framesMode()) {
       if (presented_ > 0 && args_.turntableDeg != 0.0) {
         controls_.orbitDegrees(args_.turntableDeg);
         dirty_ = true;
       }
-      while (next < script_.size() && script_[next].frame <= presented_) applyScript(script_[next++]);
       glfwPollEvents();
     } else {
       // Short waits while a frame renders (its result is collected promptly), long ones idle.
