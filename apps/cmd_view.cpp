@@ -19,7 +19,8 @@ namespace sslpv {
 CLI::App* addViewCommand(CLI::App& app, ViewArgs& args) {
   CLI::App* cmd = app.add_subcommand("view", "Watch the preview live in a window (orbit, zoom, move the light)");
   cmd->add_option("scene", args.scene, "Scene JSON file (reloaded when it or its material set changes)")->required();
-  cmd->add_option("--backend", args.backend, "cpu, vulkan, or auto (default: vulkan where it runs, else cpu)");
+  cmd->add_option("--backend", args.backend,
+                  "cpu, vulkan, or auto (default: vulkan on a GPU, cpu where the only device is lavapipe)");
   cmd->add_option("--grid", args.grid, "LPV cells along the longest axis (overrides lpv.resolution; G cycles)");
   cmd->add_option("--steps", args.steps, "Propagation steps, or 'auto' (overrides lpv.steps; S cycles)");
   cmd->add_option("--size", args.size, "Window size WxH, e.g. 640x480 (default: camera.width x camera.height)");
@@ -36,7 +37,8 @@ CLI::App* addViewCommand(CLI::App& app, ViewArgs& args) {
 int runView(const ViewArgs& args) {
   if (args.backend != "cpu" && args.backend != "vulkan" && args.backend != "auto")
     throw InputError("--backend: unknown backend '" + args.backend + "' (auto, vulkan, cpu)");
-  if (args.frames < 0) throw InputError("--frames: must be 0 (until closed) or more, got " + std::to_string(args.frames));
+  if (args.frames < 0)
+    throw InputError("--frames: must be 0 (until closed) or more, got " + std::to_string(args.frames));
   if (!args.screenshot.empty()) {
     if (args.frames == 0) throw InputError("--screenshot: needs --frames N (the frame it writes is the Nth)");
     if (std::filesystem::path(args.screenshot).extension() != ".png")

@@ -131,8 +131,8 @@ bool ViewControls::tick(double seconds) {
 Camera ViewControls::camera(int width, int height) const {
   Camera c = baseCamera_;
   c.position = c.target + camera_.offset();
-  // The up vector turns with the camera only in elevation's plane; keeping the scene's up
-  // keeps the horizon level, and the elevation limit keeps it off the view direction.
+  // The scene's up stays: the horizon stays level, and the elevation limit keeps the view
+  // direction from ever becoming parallel to it.
   c.width = width;
   c.height = height;
   return c;

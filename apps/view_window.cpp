@@ -4,16 +4,16 @@
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <system_error>
-#include <thread>
 
 #include "apps/cli_output.h"
 #include "apps/view_controls.h"
@@ -80,10 +80,12 @@ class Backend final : public FrameRenderer {
   Renderer renderer_;
 };
 
-/// Made on the render thread. "auto" tries the Vulkan backend once and stays on the CPU
-/// backend after it fails (a device without float atomics, say).
+/// Made on the render thread. "auto" takes the Vulkan backend on a real GPU only: on a
+/// CPU device (lavapipe) the CPU backend is the faster one. It tries Vulkan once and
+/// stays on the CPU backend after it fails (a device without float atomics, say).
 RendererFactory makeFactory(const std::string& backend, const gpu::VulkanDevice& device) {
-  auto vulkanFailed = std::make_shared<bool>(false);
+  auto vulkanFailed =
+      std::make_shared<bool>(backend == "auto" && device.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
   return [backend, &device, vulkanFailed](const Scene& scene) -> std::unique_ptr<FrameRenderer> {
     if (backend == "cpu" || (backend == "auto" && *vulkanFailed))
       return std::make_unique<Backend<CpuRenderer>>(scene);
