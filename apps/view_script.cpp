@@ -72,13 +72,20 @@ std::vector<ScriptEvent> loadViewScript(const std::filesystem::path& file) {
       if (path.empty()) throw InputError(where + "screenshot: expected a .png file");
       e.kind = ScriptEvent::Kind::Screenshot;
       e.file = path;
+    } else if (name == "resize") {
+      e.kind = ScriptEvent::Kind::Resize;
+      const double w = number("width"), h = number("height");
+      if (w < 1 || h < 1 || w > 4096 || h > 4096 || w != std::floor(w) || h != std::floor(h))
+        throw InputError(where + "resize: expected whole numbers of pixels from 1 to 4096");
+      e.width = int(w);
+      e.height = int(h);
     } else if (name == "wait-reload") {
       e.kind = ScriptEvent::Kind::WaitReload;
     } else if (name == "wait-reload-failed") {
       e.kind = ScriptEvent::Kind::WaitReloadFailed;
     } else {
       throw InputError(where + "unknown event '" + name +
-                       "' (drag, wheel, key, screenshot, wait-reload, wait-reload-failed)");
+                       "' (drag, wheel, key, screenshot, wait-reload, wait-reload-failed, resize)");
     }
     std::string extra;
     if (line >> extra) throw InputError(where + "unexpected '" + extra + "' after the " + name + " event");

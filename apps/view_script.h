@@ -8,6 +8,7 @@
 //   FRAME screenshot FILE.png           writes the last presented frame
 //   FRAME wait-reload                   waits until a changed scene file is shown
 //   FRAME wait-reload-failed            waits until a changed scene file fails to load
+//   FRAME resize W H                    resizes the window (the frame follows)
 // '#' starts a comment.
 #include <filesystem>
 #include <string>
@@ -18,13 +19,14 @@ namespace sslpv {
 enum class ViewKey { Quit, Grid, Steps, Rerender, Overlay, LightDrag, PlayPause, ScrubBack, ScrubForward };
 
 struct ScriptEvent {
-  enum class Kind { Drag, Wheel, Key, Screenshot, WaitReload, WaitReloadFailed };
+  enum class Kind { Drag, Wheel, Key, Screenshot, WaitReload, WaitReloadFailed, Resize };
   int frame = 0;
   int line = 0;  ///< in the script, for messages
   Kind kind = Kind::Key;
   bool rightButton = false;  ///< drag
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< drag
   double wheel = 0;
+  int width = 0, height = 0;  ///< resize
   ViewKey key = ViewKey::Quit;
   std::filesystem::path file;  ///< screenshot
 };

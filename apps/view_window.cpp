@@ -417,6 +417,17 @@ void Viewer::applyScript(const ScriptEvent& e) {
       break;
     case ScriptEvent::Kind::WaitReload:
     case ScriptEvent::Kind::WaitReloadFailed: waitForScript(e); break;
+    case ScriptEvent::Kind::Resize: {
+      glfwSetWindowSize(window_, e.width, e.height);
+      // The X server resizes asynchronously; the main loop picks the new size up.
+      const Clock::time_point deadline = Clock::now() + std::chrono::seconds(10);
+      int w = 0, h = 0;
+      do {
+        glfwWaitEventsTimeout(0.01);
+        glfwGetFramebufferSize(window_, &w, &h);
+      } while ((w != e.width || h != e.height) && Clock::now() < deadline);
+      break;
+    }
   }
 }
 

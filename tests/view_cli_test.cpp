@@ -291,6 +291,36 @@ TEST(ViewCli, VulkanBackendMatchesRenderWithValidationSilent) {
   EXPECT_LE(difference(pngBytes(dir / "first.png"), pngBytes(dir / "ref.png")).max, 1);
 }
 
+// A resized window rebuilds its swapchain and renders at the new size: the frame is the
+// render at that size (the aspect follows), with validation silent over the rebuild.
+TEST(ViewCli, ResizedWindowShowsTheRenderAtTheNewSize) {
+  if (const std::string why = xvfbSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  TempDir dir;
+  const fs::path scene = test::examplesDir() / "marble_pebble.json";
+  test::writeText(dir / "script.txt", "1 resize 96 64\n");
+  std::vector<std::string> env;
+  if (fs::exists("/usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json"))
+    env.push_back("VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation");
+  const RunResult viewed = runView(with({scene.string(), "--backend", "cpu", "--frames", "2", "--no-overlay",
+                                         "--script", (dir / "script.txt").string(), "--screenshot",
+                                         (dir / "resized.png").string()},
+                                        kFast),
+                                   env);
+  SKIP_IF_NO_WINDOW(viewed);
+  ASSERT_EQ(viewed.exitCode, 0) << viewed.stderrText;
+  const std::string output = viewed.stdoutText + viewed.stderrText;
+  EXPECT_EQ(output.find("Validation"), std::string::npos) << output;
+  std::vector<std::string> args = kFast;
+  args[1] = "96x64";
+  const RunResult rendered =
+      test::runSslpv(with({"render", scene.string(), "--backend", "cpu", "-o", (dir / "ref.png").string()}, args));
+  ASSERT_EQ(rendered.exitCode, 0) << rendered.stderrText;
+  const Image shot = readImage(dir / "resized.png");
+  EXPECT_EQ(shot.width, 96);
+  EXPECT_EQ(shot.height, 64);
+  EXPECT_LE(difference(toDisplayRgb8(shot), pngBytes(dir / "ref.png")).max, 1);
+}
+
 // Bad input fails before any window opens: exit 2 and one line naming the flag or line.
 TEST(ViewCli, RejectsBadFlagsAndScriptsWithOneLine) {
   TempDir dir;
