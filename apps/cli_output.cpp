@@ -6,6 +6,8 @@
 #include <iostream>
 #include <utility>
 
+#include "volume/error.h"
+
 namespace sslpv {
 
 void printWrote(const std::string& file, const std::string& detail, CliClock::time_point start) {
@@ -17,6 +19,21 @@ void printWrote(const std::string& file, const std::string& detail, CliClock::ti
 
 std::string imageSizeText(const Image& image) {
   return std::to_string(image.width) + "x" + std::to_string(image.height);
+}
+
+void applySizeFlag(const std::string& size, Camera& camera) {
+  const std::string expected = "--size: expected WxH with whole numbers from 1 to " + std::to_string(kMaxImageSide) +
+                               " (e.g. 640x480), got '" + size + "'";
+  const std::size_t x = size.find_first_of("xX");
+  if (x == std::string::npos || x == 0 || x + 1 == size.size()) throw InputError(expected);
+  auto side = [&](const std::string& text) {
+    if (text.size() > 6 || text.find_first_not_of("0123456789") != std::string::npos) throw InputError(expected);
+    const int value = std::stoi(text);
+    if (value < 1 || value > kMaxImageSide) throw InputError(expected);
+    return value;
+  };
+  camera.width = side(size.substr(0, x));
+  camera.height = side(size.substr(x + 1));
 }
 
 void printWarning(std::string message) {

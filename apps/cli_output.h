@@ -6,6 +6,7 @@
 #include <string>
 
 #include "volume/image_io.h"
+#include "volume/scene.h"
 
 namespace sslpv {
 
@@ -17,6 +18,11 @@ void printWrote(const std::string& file, const std::string& detail, CliClock::ti
 
 /// "WxH" of an image, the detail of printWrote for images.
 std::string imageSizeText(const Image& image);
+
+/// --size WxH (render, view): the image size instead of camera.width x camera.height (the
+/// aspect, and with it the horizontal field of view, follows the new size). InputError
+/// naming the flag on a malformed or out-of-range size.
+void applySizeFlag(const std::string& size, Camera& camera);
 
 /// "sslpv: warning: MESSAGE" on stderr, newlines flattened to keep it one line.
 void printWarning(std::string message);

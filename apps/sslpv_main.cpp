@@ -23,6 +23,7 @@
 #include "apps/cmd_export.h"
 #include "apps/cmd_edit.h"
 #include "apps/cmd_inspect.h"
+#include "apps/cmd_view.h"
 #include "apps/cli_output.h"
 #ifdef SSLPV_HAVE_VULKAN
 #include "gpu/device.h"
@@ -86,24 +87,6 @@ void warnIfOpticallyThin(const sslpv::RenderReport& report, const std::string& s
   std::cerr << text;
 }
 
-/// --size WxH: the image size instead of camera.width x camera.height (the aspect, and
-/// with it the horizontal field of view, follows the new size).
-void applySizeFlag(const std::string& size, sslpv::Camera& camera) {
-  using namespace sslpv;
-  const std::string expected = "--size: expected WxH with whole numbers from 1 to " + std::to_string(kMaxImageSide) +
-                               " (e.g. 640x480), got '" + size + "'";
-  const std::size_t x = size.find_first_of("xX");
-  if (x == std::string::npos || x == 0 || x + 1 == size.size()) throw InputError(expected);
-  auto side = [&](const std::string& text) {
-    if (text.size() > 6 || text.find_first_not_of("0123456789") != std::string::npos) throw InputError(expected);
-    const int value = std::stoi(text);
-    if (value < 1 || value > kMaxImageSide) throw InputError(expected);
-    return value;
-  };
-  camera.width = side(size.substr(0, x));
-  camera.height = side(size.substr(x + 1));
-}
-
 /// The scene warnings every renderer shares (camera or light inside the object, scale).
 void warnAboutScene(const sslpv::Scene& scene) {
   for (const std::string& warning : sslpv::sceneWarnings(scene)) sslpv::printWarning(warning);
@@ -130,7 +113,7 @@ int runRender(const RenderArgs& args) {
                      "], got " + formatNumber(args.exposure));
 
   Camera sized;
-  if (!args.size.empty()) applySizeFlag(args.size, sized);
+  if (!args.size.empty()) sslpv::applySizeFlag(args.size, sized);
 
   Scene scene = loadScene(args.scene);
   const LpvSettings settings = applyLpvFlags(scene.lpv, {args.grid, args.steps, args.shadowMap, args.scheme});
@@ -304,6 +287,8 @@ int main(int argc, char** argv) {
   CLI::App* exportCmd = sslpv::addExportCommand(app, exportArgs);
   sslpv::CompareArgs compare;
   CLI::App* compareCmd = sslpv::addCompareCommand(app, compare);
+  sslpv::ViewArgs view;
+  CLI::App* viewCmd = sslpv::addViewCommand(app, view);
 
   // CLI11 reports a stray subcommand only as "extra arguments"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {
@@ -365,6 +350,7 @@ int main(int argc, char** argv) {
     if (*paintCmd) return sslpv::runPaint(paint);
     if (*exportCmd) return sslpv::runExport(exportArgs);
     if (*compareCmd) return sslpv::runCompare(compare);
+    if (*viewCmd) return sslpv::runView(view);
     if (*inspectCmd) {
       if (!sslpv::inspectVdbFile(inspectFile, std::cout))
         return fail(kExitInput, inspectFile + ": the material set has validation problems (listed above)");

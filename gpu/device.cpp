@@ -130,9 +130,9 @@ std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
 
 VulkanDevice::VulkanDevice(const DeviceOptions& options) : log_(std::make_shared<ValidationLog>()) {
   try {
-    createInstance(options.validation);
+    createInstance(options);
     selectPhysicalDevice(options);
-    createDevice();
+    createDevice(options.swapchain);
   } catch (...) {
     release();  // the destructor does not run for a throwing constructor
     throw;
@@ -159,7 +159,8 @@ void VulkanDevice::release() {
   }
 }
 
-void VulkanDevice::createInstance(bool validation) {
+void VulkanDevice::createInstance(const DeviceOptions& options) {
+  const bool validation = options.validation;
   std::uint32_t version = VK_API_VERSION_1_0;
   if (vkEnumerateInstanceVersion(&version) != VK_SUCCESS || version < VK_API_VERSION_1_2)
     throw NoVulkanDeviceError(std::string(kNoDevice) + ": the Vulkan loader is older than 1.2");
@@ -174,8 +175,9 @@ void VulkanDevice::createInstance(bool validation) {
   app.pEngineName = "sslpv";
   // 1.3 where the device has it: the raster passes use dynamic rendering (core in 1.3).
   app.apiVersion = VK_API_VERSION_1_3;
-  // Headless: no surface extensions; windows create their own instance extensions later.
+  // Headless unless a window asks for its surface extensions.
   std::vector<const char*> extensions, layers;
+  for (const std::string& name : options.instanceExtensions) extensions.push_back(name.c_str());
   if (validation) {
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     layers.push_back(kValidationLayer);
@@ -247,7 +249,7 @@ void VulkanDevice::selectPhysicalDevice(const DeviceOptions& options) {
   vkGetPhysicalDeviceMemoryProperties(physicalDevice_, &memoryProperties_);
 }
 
-void VulkanDevice::createDevice() {
+void VulkanDevice::createDevice(bool swapchain) {
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo queueInfo{};
   queueInfo.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
@@ -270,6 +272,12 @@ void VulkanDevice::createDevice() {
   enabledAtomicFloat.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT;
   enabledAtomicFloat.shaderBufferFloat32AtomicAdd = VK_TRUE;
   if (bufferFloatAtomicAdd_) extensions.push_back(VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
+  if (swapchain) {
+    if (!hasDeviceExtension(physicalDevice_, VK_KHR_SWAPCHAIN_EXTENSION_NAME))
+      throw GpuError(std::string("Vulkan device \"") + properties_.deviceName + "\" cannot present to a window (no " +
+                     VK_KHR_SWAPCHAIN_EXTENSION_NAME + ")");
+    extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  }
 
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
@@ -302,6 +310,11 @@ bool VulkanDevice::unifiedMemory() const {
 void VulkanDevice::submit(const VkSubmitInfo& submit, VkFence fence) const {
   std::lock_guard<std::mutex> lock(queueMutex_);
   SSLPV_VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence));
+}
+
+VkResult VulkanDevice::present(const VkPresentInfoKHR& info) const {
+  std::lock_guard<std::mutex> lock(queueMutex_);
+  return vkQueuePresentKHR(queue_, &info);
 }
 
 std::vector<std::string> VulkanDevice::availableDevices() {

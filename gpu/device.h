@@ -22,6 +22,11 @@ struct DeviceOptions {
   /// Pick the first device whose name contains this (case-insensitive) substring; unset:
   /// the SSLPV_VULKAN_DEVICE environment variable, and when that is unset too, by type.
   std::optional<std::string> deviceName;
+  /// Instance extensions a window system needs to present (what glfwGetRequiredInstanceExtensions
+  /// lists); empty: a headless instance.
+  std::vector<std::string> instanceExtensions;
+  /// Enable VK_KHR_swapchain for presenting to a window; GpuError when the device lacks it.
+  bool swapchain = false;
 };
 
 /// One validation-layer (or loader) message of severity warning or error.
@@ -82,14 +87,17 @@ class VulkanDevice {
 
   /// Submits to the compute queue (Vulkan queues need external synchronization).
   void submit(const VkSubmitInfo& submit, VkFence fence) const;
+  /// vkQueuePresentKHR on the same queue, under the same lock as submit(): a window
+  /// presents while a renderer thread submits. Needs DeviceOptions::swapchain.
+  VkResult present(const VkPresentInfoKHR& info) const;
 
   /// Names of the physical devices Vulkan reports (empty when none or no Vulkan).
   static std::vector<std::string> availableDevices();
 
  private:
-  void createInstance(bool validation);
+  void createInstance(const DeviceOptions& options);
   void selectPhysicalDevice(const DeviceOptions& options);
-  void createDevice();
+  void createDevice(bool swapchain);
   void release();
 
   std::shared_ptr<ValidationLog> log_;

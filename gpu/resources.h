@@ -52,6 +52,7 @@ using PipelineLayout = DeviceObject<VkPipelineLayout, vkDestroyPipelineLayout>;
 using Pipeline = DeviceObject<VkPipeline, vkDestroyPipeline>;
 using CommandPool = DeviceObject<VkCommandPool, vkDestroyCommandPool>;
 using Fence = DeviceObject<VkFence, vkDestroyFence>;
+using Semaphore = DeviceObject<VkSemaphore, vkDestroySemaphore>;
 using QueryPool = DeviceObject<VkQueryPool, vkDestroyQueryPool>;
 
 /// Where a buffer's memory lives.

@@ -11,7 +11,7 @@ SSLPV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libglm-dev libembree-dev
   libassimp-dev nlohmann-json3-dev libcli11-dev libopenexr-dev libstb-dev
-  libgtest-dev libgmock-dev libvtk9-dev xvfb xauth
+  libgtest-dev libgmock-dev libvtk9-dev xvfb xauth libglfw3-dev
   libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools vulkan-validationlayers
   clang-14 libclang-rt-14-dev curl
 )

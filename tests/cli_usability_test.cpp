@@ -58,7 +58,8 @@ TEST(CliUsability, VersionPrintsTheVersionAndExits0) {
 TEST(CliUsability, HelpListsEveryCommandAndHelpCmdShowsItsOptions) {
   const RunResult all = runSslpv({"help"});
   EXPECT_EQ(all.exitCode, 0) << all.stderrText;
-  for (const char* cmd : {"render", "reference", "inspect", "paint", "export", "compare", "edit", "bench-error"})
+  for (const char* cmd :
+       {"render", "reference", "inspect", "paint", "export", "compare", "edit", "bench-error", "view"})
     EXPECT_TRUE(mentionsWord(all.stdoutText, cmd)) << cmd << " missing in:\n" << all.stdoutText;
   const RunResult render = runSslpv({"help", "render"});
   EXPECT_EQ(render.exitCode, 0) << render.stderrText;

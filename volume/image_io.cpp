@@ -266,22 +266,25 @@ Image readExr(const fs::path& file) {
 
 // ---- PNG: display-referred 8-bit sRGB.
 
-void writePng(const Image& image, const fs::path& path, const fs::path& target, float exposure) {
-  const std::vector<unsigned char> bytes = toDisplayRgb8(image, exposure);
+void writePngBytes(const std::vector<unsigned char>& bytes, int width, int height, const fs::path& path,
+                   const fs::path& target) {
   // Encode to memory and write it ourselves: stbi_write_png ignores fwrite errors, so a
   // full disk would go unnoticed and a truncated PNG would be renamed over the target.
   std::string encoded;
   auto append = [](void* context, void* data, int size) {
     static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
   };
-  if (!stbi_write_png_to_func(append, &encoded, image.width, image.height, 3, bytes.data(),
-                              image.width * 3))
+  if (!stbi_write_png_to_func(append, &encoded, width, height, 3, bytes.data(), width * 3))
     throw InputError(target.string() + ": cannot encode PNG");
   std::ofstream out(path, std::ios::binary);
   if (!out) throw InputError(target.string() + ": cannot open for writing");
   out.write(encoded.data(), std::streamsize(encoded.size()));
   out.close();
   if (!out) throwWriteFailed(target, errno);
+}
+
+void writePng(const Image& image, const fs::path& path, const fs::path& target, float exposure) {
+  writePngBytes(toDisplayRgb8(image, exposure), image.width, image.height, path, target);
 }
 
 Image readPng(const fs::path& file) {
@@ -310,6 +313,15 @@ std::vector<unsigned char> toDisplayRgb8(const Image& image, float exposure) {
       bytes[i * 3 + c] = static_cast<unsigned char>(std::lround(linearToSrgb(v) * 255.0f));
     }
   return bytes;
+}
+
+void writeDisplayPng(const std::vector<unsigned char>& rgb, int width, int height, const fs::path& file) {
+  if (formatOf(file) != ImageFormat::Png)
+    throw InputError(file.string() + ": a displayed frame is written as .png only");
+  if (width <= 0 || height <= 0 || rgb.size() != std::size_t(width) * std::size_t(height) * 3)
+    throw std::invalid_argument("writeDisplayPng(" + file.string() + "): " + std::to_string(rgb.size()) +
+                                " bytes for " + std::to_string(width) + "x" + std::to_string(height));
+  writeAtomically(file, [&](const fs::path& temp) { writePngBytes(rgb, width, height, temp, file); });
 }
 
 bool isSupportedImageExtension(const fs::path& file) {

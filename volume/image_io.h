@@ -31,6 +31,10 @@ AtomicOutput imageOutput(const Image& image, const std::filesystem::path& file, 
 /// interleaved, row 0 the top row: what a window shows of a rendered image.
 std::vector<unsigned char> toDisplayRgb8(const Image& image, float exposure = 1.0f);
 
+/// Writes bytes in toDisplayRgb8's layout (a window's frame, already display-encoded) as a
+/// PNG, atomically; `file` must end in .png (InputError otherwise).
+void writeDisplayPng(const std::vector<unsigned char>& rgb, int width, int height, const std::filesystem::path& file);
+
 /// Reads .pfm or .exr (linear) or .png (converted back to linear). InputError when
 /// unreadable, truncated or of another format.
 Image readImage(const std::filesystem::path& file);
