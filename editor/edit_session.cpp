@@ -302,6 +302,7 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
   if (draftRenderer) {
     m.draft.settings = draftSettings(settings);
     m.draft.worker = std::make_unique<PreviewWorker>(std::move(draftRenderer));
+    m.draft.cameraChanged = true;  // its first job gives it the draft's image size
   }
 }
 
@@ -405,7 +406,15 @@ std::uint64_t EditSession::requestPreview(PreviewQuality quality) {
     c.wholeSet = false;
     c.touched.reset();
   }
-  if (c.cameraChanged) job.camera = m.camera;
+  if (c.cameraChanged) {
+    job.camera = m.camera;
+    // Half the pixels each way: shading is most of a 16³ frame's time, and the window
+    // scales the image to the same size on screen.
+    if (job.draft) {
+      job.camera->width = std::max(kMinPreviewSide, (m.previewWidth + 1) / 2);
+      job.camera->height = std::max(kMinPreviewSide, (m.previewHeight + 1) / 2);
+    }
+  }
   c.cameraChanged = false;
   c.requestedVersion = m.version;
   // A full frame of this state makes a draft of it pointless.

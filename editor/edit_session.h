@@ -74,8 +74,8 @@ struct PreviewOptions {
 };
 
 /// Full: the preview's own settings. Draft: the same view on a kDraftPreviewResolution³
-/// grid, for the frames during a stroke; where the preview's grid is not finer than that,
-/// a draft is a full frame.
+/// grid at half the image size each way, for the frames during a stroke; where the
+/// preview's grid is not finer than that, a draft is a full frame.
 enum class PreviewQuality { Draft, Full };
 
 /// One finished preview frame, rendered off the UI thread.

@@ -8,6 +8,7 @@
 // not as a wall-clock race.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <memory>
@@ -194,9 +195,9 @@ TEST(PreviewAsync, AnOlderFrameFinishingLateIsDropped) {
 }
 
 TEST(PreviewAsync, StrokesShowDraftsOnTheCoarseGridThenTheFullFrame) {
-  // Grid 32: a draft is a 16³ frame of the current voxels (it changes as the stroke does),
-  // a full frame is 32³; a full request also answers a pending draft's staleness. At grid
-  // 16 a draft is a full frame.
+  // Grid 32: a draft is a 16³ frame of the current voxels (it changes as the stroke does)
+  // at half the image size, a full frame is 32³; a full request also answers a pending
+  // draft's staleness. At grid 16 a draft is a full frame.
   ordered json = sceneJson();
   json["lpv"]["resolution"] = 32;
   Files f(json);
@@ -217,7 +218,8 @@ TEST(PreviewAsync, StrokesShowDraftsOnTheCoarseGridThenTheFullFrame) {
   EXPECT_TRUE(draft->draft);
   EXPECT_EQ(draft->resolution, kDraftPreviewResolution);
   EXPECT_EQ(draft->report.frame.dims.x, kDraftPreviewResolution) << "the frame was not rendered on the draft grid";
-  EXPECT_EQ(draft->image.width, clean.width);
+  EXPECT_EQ(draft->image.width, (clean.width + 1) / 2) << "drafts are half the size each way";
+  EXPECT_EQ(draft->image.height, std::max(16, (clean.height + 1) / 2));
   s.endStroke();
 
   s.requestPreview(PreviewQuality::Full);
