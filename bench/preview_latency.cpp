@@ -6,9 +6,14 @@
 // changed (every cell resampled, then propagation and shading) on a second renderer at
 // the same settings, run alternately with the strokes: inc/full is how much the region
 // path saves on this machine.
+// The editor renders its preview on a worker thread: "ui" is what a stroke costs the UI
+// thread that way (paint + requestPreview, which copies the set for the worker), "shown"
+// is from the end of the stroke until its frame is finished. "total" (paint + a frame the
+// caller waits for) is what the UI thread was blocked for when the preview rendered on it.
+// "draft" is a mid-stroke draft frame (kDraftPreviewResolution³), request to arrival.
 // Prints medians of --runs after --warmup runs.
 // Usage: preview_latency [--examples DIR] [--runs N] [--warmup N] [--size PX]
-//                        [--backend cpu|vulkan|both]
+//                        [--backend cpu|vulkan|both] [--grid 32|64|both]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -49,6 +54,8 @@ double median(std::vector<double> v) {
 
 struct Run {
   double paint = 0, preview = 0, total = 0;
+  double ui = 0, shown = 0;  ///< the asynchronous stroke: UI-thread time, end of stroke to frame
+  double draft = 0;          ///< mid-stroke: request to finished draft frame
   double resample = 0, propagation = 0, shading = 0, other = 0;
   double cells = 0, voxels = 0, dabs = 0, steps = 0;
 };
@@ -151,6 +158,29 @@ Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, boo
     const Image fullImage = full->render(session.previewSettings(), &fullFrame);
     const double fullWall = ms(t3, Clock::now());
     row.maxDifference = std::max(row.maxDifference, maxRelativeDifference(preview, fullImage));
+
+    // The same stroke as the editor now runs it: the UI thread paints and hands the state
+    // over, the frame follows on the worker. A third target, so that this stroke and the
+    // next run's each change every voxel they reach as much as the strokes above.
+    brush.albedo = glm::dvec3(0.6, 0.7, 0.9);
+    const Clock::time_point a0 = Clock::now();
+    session.beginStroke(brush);
+    session.addPoints(points);
+    session.endStroke();
+    session.requestPreview(PreviewQuality::Full);
+    const Clock::time_point a1 = Clock::now();
+    session.waitForPreview();
+    run.ui = ms(a0, a1);
+    run.shown = ms(a1, Clock::now());
+
+    // What the editor shows during a stroke: a draft (kDraftPreviewResolution³) after a dab.
+    session.beginStroke(brush);
+    session.addPoints(points);
+    const Clock::time_point d0 = Clock::now();
+    session.requestPreview(PreviewQuality::Draft);
+    session.waitForPreview();
+    run.draft = ms(d0, Clock::now());
+    session.endStroke();
     if (i < warmup) continue;
     samples.push_back(run);
     fullMs.push_back(fullWall);
@@ -170,6 +200,9 @@ Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, boo
   m.voxels = medianOf(samples, [](const Run& r) { return r.voxels; });
   m.dabs = medianOf(samples, [](const Run& r) { return r.dabs; });
   m.steps = medianOf(samples, [](const Run& r) { return r.steps; });
+  m.ui = medianOf(samples, [](const Run& r) { return r.ui; });
+  m.shown = medianOf(samples, [](const Run& r) { return r.shown; });
+  m.draft = medianOf(samples, [](const Run& r) { return r.draft; });
 
   row.full = median(fullMs);
   row.fullResample = median(fullResample);
@@ -181,11 +214,11 @@ Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, boo
 void printRow(const Row& r) {
   std::printf(
       "%-18s %-7s %4d %5s %5.0f %4.0f %8.0f %7.0f/%-7zu | %8.2f | %8.2f %7.2f %8.2f %7.2f %6.2f | %8.2f | %8.2f "
-      "(%7.2f %8.2f %5.0f) %8.2f | %6.3f %6.3f %8.1e\n",
+      "(%7.2f %8.2f %5.0f) %8.2f | %6.3f %6.3f %8.1e | %7.2f %8.2f %7.2f\n",
       r.scene.c_str(), r.backend.substr(0, r.backend.find(' ')).c_str(), r.grid, r.autoSteps ? "auto" : "8",
       r.med.steps, r.med.dabs, r.med.voxels, r.med.cells, r.gridCells, r.med.paint, r.med.preview, r.med.resample,
       r.med.propagation, r.med.shading, r.med.other, r.med.total, r.full, r.fullResample, r.fullPropagation, r.fullSteps, r.cold,
-      r.med.preview / r.full, r.med.total / r.full, r.maxDifference);
+      r.med.preview / r.full, r.med.total / r.full, r.maxDifference, r.med.ui, r.med.shown, r.med.draft);
 }
 
 }  // namespace
@@ -194,6 +227,7 @@ int main(int argc, char** argv) {
   fs::path examples = fs::path(SSLPV_SOURCE_DIR) / "examples";
   int runs = 9, warmup = 2, size = 256;
   std::string backends = "both";
+  std::string grids = "both";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--examples"))
       examples = argv[i + 1];
@@ -205,16 +239,19 @@ int main(int argc, char** argv) {
       size = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--backend"))
       backends = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--grid"))
+      grids = argv[i + 1];
     else {
       std::fprintf(stderr,
                    "usage: preview_latency [--examples DIR] [--runs N] [--warmup N] [--size PX] "
-                   "[--backend cpu|vulkan|both]\n");
+                   "[--backend cpu|vulkan|both] [--grid 32|64|both]\n");
       return 2;
     }
   }
-  if (argc % 2 == 0 || (backends != "cpu" && backends != "vulkan" && backends != "both")) {
+  if (argc % 2 == 0 || (backends != "cpu" && backends != "vulkan" && backends != "both") ||
+      (grids != "32" && grids != "64" && grids != "both")) {
     std::fprintf(stderr, "usage: preview_latency [--examples DIR] [--runs N] [--warmup N] [--size PX] "
-                         "[--backend cpu|vulkan|both]\n");
+                         "[--backend cpu|vulkan|both] [--grid 32|64|both]\n");
     return 2;
   }
   std::printf("preview_latency:");
@@ -228,11 +265,14 @@ int main(int argc, char** argv) {
               "the full frame's (from scratch); cold = the session's first frame (everything, incl. one-time\n"
               "setup); inc/full = preview/full, "
               "tot/full = (paint+preview)/full;\n"
-              "maxdiff = largest relative pixel difference, incremental preview vs the full frame (all runs)\n\n");
-  std::printf("%-18s %-7s %4s %5s %5s %4s %8s %15s | %8s | %8s %7s %8s %7s %6s | %8s | %8s (%7s %8s %5s) %8s | %6s %6s %8s\n",
+              "maxdiff = largest relative pixel difference, incremental preview vs the full frame (all runs);\n"
+              "ui = the same stroke as the editor runs it: paint + requestPreview (the UI thread's share; total is\n"
+              "what it was with the frame rendered on the UI thread); shown = end of that stroke to its frame;\n"
+              "draft = mid-stroke, a draft frame's request to its arrival\n\n");
+  std::printf("%-18s %-7s %4s %5s %5s %4s %8s %15s | %8s | %8s %7s %8s %7s %6s | %8s | %8s (%7s %8s %5s) %8s | %6s %6s %8s | %7s %8s %7s\n",
               "scene", "backend", "grid", "steps", "ran", "dabs", "voxels", "cells resampled", "paint", "preview",
               "resamp", "propag", "shade", "other", "total", "full", "resamp", "propag", "steps", "cold", "inc/f", "tot/f",
-              "maxdiff");
+              "maxdiff", "ui", "shown", "draft");
 
   std::vector<PreviewBackendKind> kinds;
   if (backends != "vulkan") kinds.push_back(PreviewBackendKind::Cpu);
@@ -243,6 +283,7 @@ int main(int argc, char** argv) {
       for (int grid : {32, 64})
         for (bool autoSteps : {true, false}) {
           if (kind == PreviewBackendKind::Vulkan && vulkanMissing) continue;
+          if (grids != "both" && std::to_string(grid) != grids) continue;
           try {
             printRow(measure(examples / name, kind, grid, autoSteps, size, warmup, runs));
             std::fflush(stdout);

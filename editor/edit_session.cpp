@@ -8,8 +8,10 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 #include <system_error>
 
+#include "editor/preview_worker.h"
 #include "volume/atomic_file.h"
 #include "volume/error.h"
 #include "volume/material_set.h"
@@ -66,6 +68,21 @@ MaterialSet forWriting(const MaterialSet& set) {
   MaterialSet out = set;
   out.creator = kCreator;
   return out;
+}
+
+/// A draft frame's settings: the same view on the draft grid.
+LpvSettings draftSettings(LpvSettings s) {
+  // A fixed step count is a reach in cells: the coarser grid needs proportionally fewer
+  // steps to carry light as far.
+  if (!s.autoSteps)
+    s.steps = std::max(1, int(std::lround(double(s.steps) * kDraftPreviewResolution / double(s.resolution))));
+  s.resolution = kDraftPreviewResolution;
+  return s;
+}
+
+/// Of two finished frames, the one showing the newer request.
+void keepNewer(std::optional<PreviewFrame>& best, std::optional<PreviewFrame> candidate) {
+  if (candidate && (!best || candidate->serial > best->serial)) best = std::move(candidate);
 }
 
 void unite(std::optional<Bounds>& into, const Bounds& b) {
@@ -133,20 +150,58 @@ struct EditSession::Impl {
   std::uint64_t changes = 0;
   std::uint64_t autosavedChanges = 0;
 
-  // Preview.
-  std::unique_ptr<PreviewRenderer> renderer;
-  LpvSettings settings;
+  // Preview: one worker per quality; `draft` has none when drafts are full frames.
+  struct PreviewChannel {
+    std::unique_ptr<PreviewWorker> worker;
+    LpvSettings settings;
+    std::optional<Bounds> touched;  ///< world region changed since this channel's last request
+    bool wholeSet = true;           ///< the whole set changed (start, recover, a region lost)
+    bool cameraChanged = false;
+    std::uint64_t requestedVersion = 0;
+  };
+  PreviewChannel full, draft;
+  std::string backendName;
   int previewWidth = 0, previewHeight = 0;
   Camera camera;
-  std::optional<Bounds> touched;  ///< world region changed since the last renderPreview
-  bool resampleAll = true;        ///< the whole set changed (start, recover, a region lost)
-  bool stale = true;
+  std::uint64_t version = 1;          ///< bumps with every change a preview shows
+  std::uint64_t materialVersion = 1;  ///< bumps with every change of the voxels
+  /// The set as of materialVersion snapshotVersion, shared by the jobs that carry it.
+  std::shared_ptr<const MaterialSet> snapshot;
+  std::uint64_t snapshotVersion = 0;
+  std::uint64_t nextSerial = 1;
+  std::uint64_t shownSerial = 0;  ///< the newest frame takePreview() returned
 
   std::uint64_t topId() const { return undoIds.empty() ? baseId : undoIds.back(); }
 
+  PreviewChannel& channel(PreviewQuality quality) {
+    return quality == PreviewQuality::Draft && draft.worker ? draft : full;
+  }
+  const PreviewChannel& channel(PreviewQuality quality) const {
+    return quality == PreviewQuality::Draft && draft.worker ? draft : full;
+  }
+
   void materialChanged(const Bounds& region) {
-    unite(touched, region);
-    stale = true;
+    for (PreviewChannel* c : {&full, &draft}) unite(c->touched, region);
+    ++version;
+    ++materialVersion;
+  }
+
+  void wholeSetChanged() {
+    for (PreviewChannel* c : {&full, &draft}) {
+      c->wholeSet = true;
+      c->touched.reset();
+    }
+    ++version;
+    ++materialVersion;
+  }
+
+  /// Deep: the engine paints its set in place while the workers read their copy.
+  std::shared_ptr<const MaterialSet> snapshotSet() {
+    if (!snapshot || snapshotVersion != materialVersion) {
+      snapshot = deepCopy(*engine->materialSet());
+      snapshotVersion = materialVersion;
+    }
+    return snapshot;
   }
 
   StrokeResult recordStroke(const StrokeResult& result) {
@@ -169,10 +224,7 @@ struct EditSession::Impl {
       return result;
     } catch (...) {
       // Dabs before the failing one may have written voxels whose region was not returned.
-      if (engine->strokeInProgress()) {
-        resampleAll = true;
-        stale = true;
-      }
+      if (engine->strokeInProgress()) wholeSetChanged();
       throw;
     }
   }
@@ -218,8 +270,8 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
   m.targetTemplate.set.reset();
   m.engine = std::make_unique<BrushEngine>(std::move(target));
 
-  m.settings = preview.lpv.value_or(m.scene.lpv);
-  checkSettings(m.settings);
+  const LpvSettings settings = preview.lpv.value_or(m.scene.lpv);
+  checkSettings(settings);
   if (preview.longestSide < kMinPreviewSide || preview.longestSide > kMaxImageSide)
     throw InputError("preview size: the longest side must be in [" + std::to_string(kMinPreviewSide) + ", " +
                      std::to_string(kMaxImageSide) + "] pixels, got " + std::to_string(preview.longestSide));
@@ -231,12 +283,27 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
   m.camera.width = m.previewWidth;
   m.camera.height = m.previewHeight;
 
-  // The renderer gets the engine's live set before its first frame, so it need not load
-  // the file again.
+  // The renderer gets a snapshot of the engine's set with its first job, so it need not
+  // load the file again.
   Scene previewScene = m.scene;
   previewScene.camera = m.camera;
   previewScene.material.vdb.reset();
-  m.renderer = makePreviewRenderer(previewScene, preview.backend);
+  const PreviewRendererFactory make =
+      preview.makeRenderer ? preview.makeRenderer : PreviewRendererFactory(makePreviewRenderer);
+  std::unique_ptr<PreviewRenderer> renderer = make(previewScene, preview.backend);
+  m.backendName = renderer->name();
+  // Drafts render on the CPU whatever the backend: a 16³ frame takes milliseconds there,
+  // less than creating a second Vulkan device would. Both renderers exist before either
+  // worker thread starts (the mesh reader forks).
+  std::unique_ptr<PreviewRenderer> draftRenderer;
+  if (settings.resolution > kDraftPreviewResolution) draftRenderer = make(previewScene, PreviewBackendKind::Cpu);
+  m.full.settings = settings;
+  m.full.worker = std::make_unique<PreviewWorker>(std::move(renderer));
+  if (draftRenderer) {
+    m.draft.settings = draftSettings(settings);
+    m.draft.worker = std::make_unique<PreviewWorker>(std::move(draftRenderer));
+    m.draft.cameraChanged = true;  // its first job gives it the draft's image size
+  }
 }
 
 EditSession::~EditSession() = default;
@@ -290,7 +357,6 @@ std::optional<StrokeResult> EditSession::undo() {
   m.undoIds.pop_back();
   ++m.changes;
   m.materialChanged(result->worldBounds);
-  m.stale = true;
   return result;
 }
 
@@ -302,7 +368,6 @@ std::optional<StrokeResult> EditSession::redo() {
   m.redoIds.pop_back();
   ++m.changes;
   m.materialChanged(result->worldBounds);
-  m.stale = true;
   return result;
 }
 
@@ -318,30 +383,82 @@ void EditSession::setPreviewCamera(const Camera& camera) {
   m.camera = camera;
   m.camera.width = m.previewWidth;
   m.camera.height = m.previewHeight;
-  m.renderer->setCamera(m.camera);
-  m.stale = true;
+  m.full.cameraChanged = m.draft.cameraChanged = true;
+  ++m.version;
 }
 
 const Camera& EditSession::previewCamera() const { return impl_->camera; }
-bool EditSession::previewStale() const { return impl_->stale; }
-
-Image EditSession::renderPreview(RenderReport* report) {
-  Impl& m = *impl_;
-  // The set is painted in place, so the renderer's pointer already sees the new voxels;
-  // passing it again rebuilds the field and hands over the region to resample.
-  if (m.resampleAll)
-    m.renderer->setMaterialSet(m.engine->materialSet(), std::nullopt);
-  else if (m.touched)
-    m.renderer->setMaterialSet(m.engine->materialSet(), m.touched);
-  m.resampleAll = false;
-  m.touched.reset();
-  Image image = m.renderer->render(m.settings, report);
-  m.stale = false;
-  return image;
+bool EditSession::previewStale(PreviewQuality quality) const {
+  return impl_->channel(quality).requestedVersion != impl_->version;
 }
 
-std::string EditSession::previewBackendName() const { return impl_->renderer->name(); }
-const LpvSettings& EditSession::previewSettings() const { return impl_->settings; }
+std::uint64_t EditSession::requestPreview(PreviewQuality quality) {
+  Impl& m = *impl_;
+  Impl::PreviewChannel& c = m.channel(quality);
+  PreviewJob job;
+  job.serial = m.nextSerial++;
+  job.draft = &c == &m.draft;
+  job.settings = c.settings;
+  if (c.wholeSet || c.touched) {
+    job.set = m.snapshotSet();
+    job.wholeSet = c.wholeSet;
+    job.touched = c.touched;
+    c.wholeSet = false;
+    c.touched.reset();
+  }
+  if (c.cameraChanged) {
+    job.camera = m.camera;
+    // Half the pixels each way: shading is most of a 16³ frame's time, and the window
+    // scales the image to the same size on screen.
+    if (job.draft) {
+      job.camera->width = std::max(kMinPreviewSide, (m.previewWidth + 1) / 2);
+      job.camera->height = std::max(kMinPreviewSide, (m.previewHeight + 1) / 2);
+    }
+  }
+  c.cameraChanged = false;
+  c.requestedVersion = m.version;
+  // A full frame of this state makes a draft of it pointless.
+  if (&c == &m.full) m.draft.requestedVersion = m.version;
+  const std::uint64_t serial = job.serial;
+  c.worker->submit(std::move(job));
+  return serial;
+}
+
+std::optional<PreviewFrame> EditSession::takePreview() {
+  Impl& m = *impl_;
+  std::optional<PreviewFrame> newest;
+  for (Impl::PreviewChannel* c : {&m.full, &m.draft})
+    if (c->worker) keepNewer(newest, c->worker->take());
+  if (!newest || newest->serial <= m.shownSerial) return std::nullopt;
+  m.shownSerial = newest->serial;
+  return newest;
+}
+
+bool EditSession::previewBusy(PreviewQuality quality) const { return impl_->channel(quality).worker->busy(); }
+
+std::optional<PreviewFrame> EditSession::waitForPreview() {
+  Impl& m = *impl_;
+  std::optional<PreviewFrame> newest;
+  for (Impl::PreviewChannel* c : {&m.full, &m.draft})
+    if (c->worker) keepNewer(newest, c->worker->wait());
+  if (!newest || newest->serial <= m.shownSerial) return std::nullopt;
+  m.shownSerial = newest->serial;
+  return newest;
+}
+
+Image EditSession::renderPreview(RenderReport* report) {
+  const std::uint64_t serial = requestPreview(PreviewQuality::Full);
+  // The newest request, so the frame waitForPreview() returns is this one.
+  std::optional<PreviewFrame> frame = waitForPreview();
+  if (!frame || frame->serial != serial) throw std::logic_error("renderPreview: the requested frame went missing");
+  if (frame->failure) std::rethrow_exception(frame->failure);
+  if (report) *report = frame->report;
+  return std::move(frame->image);
+}
+
+std::string EditSession::previewBackendName() const { return impl_->backendName; }
+const LpvSettings& EditSession::previewSettings() const { return impl_->full.settings; }
+int EditSession::draftResolution() const { return impl_->channel(PreviewQuality::Draft).settings.resolution; }
 
 void EditSession::save(bool replaceConfirmed) {
   Impl& m = *impl_;
@@ -456,9 +573,7 @@ void EditSession::recover() {
   m.strokeWrote = false;
   ++m.changes;
   m.autosavedChanges = m.changes;  // the recovery file holds exactly this state
-  m.touched.reset();
-  m.resampleAll = true;
-  m.stale = true;
+  m.wholeSetChanged();
 }
 
 void EditSession::discardRecovery() {

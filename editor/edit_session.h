@@ -23,7 +23,9 @@
 // file; a recovered state counts as unsaved.
 #include <chrono>
 #include <cstdint>
+#include <exception>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -55,12 +57,38 @@ class PreviewRenderer {
 /// bad scene.
 std::unique_ptr<PreviewRenderer> makePreviewRenderer(const Scene& scene, PreviewBackendKind backend);
 
+/// Builds a preview renderer. Tests put a deliberately slow or counting renderer here.
+using PreviewRendererFactory = std::function<std::unique_ptr<PreviewRenderer>(const Scene&, PreviewBackendKind)>;
+
+/// The grid of the draft frames shown during a stroke (PreviewQuality::Draft).
+constexpr int kDraftPreviewResolution = 16;
+
 struct PreviewOptions {
   PreviewBackendKind backend = PreviewBackendKind::Cpu;
   /// Longest side of the preview image in pixels; the scene camera's aspect is kept.
   int longestSide = 256;
   /// LPV settings of the preview; absent: the scene's lpv settings.
   std::optional<LpvSettings> lpv;
+  /// Absent: makePreviewRenderer.
+  PreviewRendererFactory makeRenderer;
+};
+
+/// Full: the preview's own settings. Draft: the same view on a kDraftPreviewResolution³
+/// grid at half the image size each way, for the frames during a stroke; where the
+/// preview's grid is not finer than that, a draft is a full frame.
+enum class PreviewQuality { Draft, Full };
+
+/// One finished preview frame, rendered off the UI thread.
+struct PreviewFrame {
+  Image image;  ///< empty when `error` is set
+  RenderReport report;
+  std::uint64_t serial = 0;  ///< the requestPreview() whose state it shows
+  bool draft = false;
+  int resolution = 0;    ///< LPV grid side
+  double renderMs = 0;   ///< the worker's wall time for the frame
+  std::chrono::steady_clock::time_point finished;
+  std::string error;     ///< the render failed: the one-line reason
+  std::exception_ptr failure;  ///< and what the renderer threw
 };
 
 struct SessionPaths {
@@ -118,15 +146,32 @@ class EditSession {
   /// compares it to decide when the preview and the autosave are stale.
   std::uint64_t changeCount() const;
 
-  // Preview.
+  // Preview. Frames are rendered on worker threads (editor/preview_worker.h): the calls
+  // below never wait for a render, except renderPreview() and waitForPreview().
   void setPreviewCamera(const Camera& camera);  ///< width/height are replaced by the preview size
   const Camera& previewCamera() const;
-  /// True when a stroke, undo, redo or camera change happened since the last renderPreview.
-  bool previewStale() const;
-  /// Re-renders what changed since the last call: only the touched region is resampled.
+  /// True when a stroke, dab, undo, redo or camera change happened since the last request
+  /// of `quality` (a Full request or renderPreview() also satisfies Draft).
+  bool previewStale(PreviewQuality quality = PreviewQuality::Full) const;
+  /// Hands the current state to the preview's worker and returns at once with the
+  /// request's serial. What the worker reads is copied here (the set only where it
+  /// changed since the last request): painting on goes on while it renders. A request not
+  /// yet started is replaced by this one; a frame in progress finishes first.
+  std::uint64_t requestPreview(PreviewQuality quality);
+  /// The newest finished frame not returned before, if it shows a newer request than
+  /// every frame returned so far (an older state finishing late is dropped).
+  std::optional<PreviewFrame> takePreview();
+  /// A requested frame of `quality` is pending or rendering.
+  bool previewBusy(PreviewQuality quality) const;
+  /// Waits until every requested frame is finished, then takePreview().
+  std::optional<PreviewFrame> waitForPreview();
+  /// requestPreview(Full) and its frame: re-renders what changed since the last full
+  /// frame (only the touched region is resampled). Throws what the renderer threw.
   Image renderPreview(RenderReport* report = nullptr);
   std::string previewBackendName() const;
   const LpvSettings& previewSettings() const;
+  /// The LPV grid side of a draft frame (the preview's when drafts are full frames).
+  int draftResolution() const;
 
   // Files. Throw InputError/ResourceError with a one-line reason; on failure nothing in
   // memory changes and the previous files stay intact.

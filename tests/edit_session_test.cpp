@@ -16,6 +16,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "edit_session_support.h"
 #include "material_compare.h"
 #include "test_support.h"
 #include "volume/cpu_renderer.h"
@@ -26,38 +27,6 @@ namespace sslpv::test {
 namespace {
 
 namespace fs = std::filesystem;
-using ordered = nlohmann::ordered_json;
-
-/// Box [-5,5]^3 seen from +z (front face z = 5), keys deliberately not in alphabetical
-/// order, so a rewrite that sorts keys shows. Camera 64x48 (4:3).
-ordered sceneJson() {
-  return ordered::parse(R"({
-    "units": "mm",
-    "mesh": {"primitive": "box", "min": [-5, -5, -5], "max": [5, 5, 5]},
-    "camera": {"position": [6, 8, 30], "target": [0, 0, 0], "fov_y_deg": 35, "width": 64, "height": 48},
-    "material": {"base": {"sigma_t": [1.0, 1.2, 1.4], "sigma_s": [0.9, 1.0, 1.1], "g": 0.1}, "ior": 1.3},
-    "lights": [{"type": "point", "position": [10, 15, 30], "intensity": [2000, 2000, 2000]}],
-    "lpv": {"resolution": 16, "steps": 8, "shadow_map": 128}
-  })");
-}
-
-PreviewOptions smallPreview() {
-  PreviewOptions options;
-  options.longestSide = 64;
-  return options;
-}
-
-/// A darkening stroke just under the front face: albedo 0.2-0.4, short mean free path.
-Stroke darkStroke(double x = 0.0) {
-  Stroke s;
-  s.brush.channel = BrushChannel::AlbedoMfp;
-  s.brush.mode = BrushMode::Set;
-  s.brush.albedo = glm::dvec3(0.2, 0.3, 0.4);
-  s.brush.meanFreePath = glm::dvec3(0.3);
-  s.brush.radius = 1.5;
-  s.points = {{x, 0.0, 4.0}, {x + 1.0, 1.0, 4.0}};
-  return s;
-}
 
 std::vector<std::string> listDir(const fs::path& dir) {
   std::vector<std::string> names;
@@ -66,14 +35,6 @@ std::vector<std::string> listDir(const fs::path& dir) {
   return names;
 }
 
-
-/// A full render of `sceneFile` by a fresh CPU renderer, at the session's preview view.
-Image freshRender(const fs::path& sceneFile, const EditSession& session) {
-  Scene scene = loadScene(sceneFile);
-  scene.camera = session.previewCamera();
-  CpuRenderer renderer(scene);
-  return renderer.render(session.previewSettings());
-}
 
 /// A set made by another tool, as the examples' (creator "sslpv make_examples").
 void saveHandMade(MaterialSet set, const fs::path& file) {
@@ -86,12 +47,6 @@ void saveAsPaintedOutput(MaterialSet set, const fs::path& file) {
   set.creator = "sslpv edit";
   saveMaterialSet(set, file);
 }
-
-struct Files {
-  TempDir dir;
-  fs::path scene = dir / "scene.json";
-  explicit Files(const ordered& json = sceneJson()) { writeText(scene, json.dump(2)); }
-};
 
 TEST(EditSession, UnsavedFollowsTheHistoryPosition) {
   // Saved = the revision on top of the undo stack at load/save; undoing back to it is

@@ -163,14 +163,21 @@ int run(const Options& options) {
     recorder->Play();
     window.refresh();
   }
-  if (!options.screenshot.empty()) writeScreenshot(window.renderWindow(), options.screenshot);
+  if (!options.screenshot.empty()) {
+    // A scripted run's picture is of the final state: its preview frame, not whichever
+    // draft or earlier frame had arrived when the script ended.
+    window.settlePreview();
+    writeScreenshot(window.renderWindow(), options.screenshot);
+  }
   if (!options.exitAfter && !window.quitRequested()) {
     if (!options.record.empty()) {
       recorder->SetFileName(options.record.c_str());
       recorder->On();
       recorder->Record();
     }
-    interactor->CreateRepeatingTimer(500);
+    // Also how finished preview frames reach the screen: 50 ms keeps their delay short
+    // (a poll is two uncontended mutex locks).
+    interactor->CreateRepeatingTimer(50);
     interactor->Start();
     if (recorder) recorder->Stop();
   }

@@ -106,7 +106,10 @@ EditWindow::EditWindow(EditSession& session, const EditWindowOptions& options)
   recoveryPending_ = options.offerRecovery && findRecoveryFile(session.scene().file).has_value();
   buildScene();
   updateSlices();
-  updatePreview();
+  // The first frame renders everything and can take seconds: the window opens at once and
+  // shows the progress note until it arrives.
+  requestPreview(PreviewQuality::Full);
+  updatePreviewLabel();
   updateStatus();
   if (recoveryPending_) {
     const std::filesystem::path file = *findRecoveryFile(session.scene().file);
@@ -213,6 +216,13 @@ void EditWindow::buildScene() {
   unsavedMarker_ = makeText(overlay_, 14, 0.005, 0.93);
   previewLabel_ = makeText(overlay_, 12, 0.505, 0.965);
   previewLabel_->GetTextProperty()->SetColor(0.8, 0.8, 0.8);
+  previewProgress_ = makeText(overlay_, 15, 0.75, 0.5 * (1.0 + kSliceRowTop));
+  previewProgress_->GetTextProperty()->SetJustificationToCentered();
+  previewProgress_->GetTextProperty()->SetVerticalJustificationToCentered();
+  previewProgress_->GetTextProperty()->SetColor(1.0, 0.85, 0.2);
+  previewProgress_->GetTextProperty()->SetBackgroundColor(0.0, 0.0, 0.0);
+  previewProgress_->GetTextProperty()->SetBackgroundOpacity(0.7);
+  previewProgress_->SetVisibility(false);
   help_ = makeText(overlay_, 14, 0.03, 0.12);
   help_->SetInput(kHelpText);
   help_->GetTextProperty()->SetBackgroundColor(0.0, 0.0, 0.0);
@@ -228,16 +238,57 @@ void EditWindow::updateSlices() {
   slices_->update(field, controls_.displayChannel(), scene.units);
 }
 
-void EditWindow::updatePreview() {
-  const auto start = std::chrono::steady_clock::now();
-  Image image;
+void EditWindow::requestPreview(PreviewQuality quality) {
   try {
-    image = session_.renderPreview();
+    session_.requestPreview(quality);
   } catch (const std::exception& e) {
+    // Copying the set for the worker ran out of memory, say: painting goes on.
     showMessage(std::string("preview failed: ") + e.what(), true);
     return;
   }
-  const double ms = msSince(start);
+  if (quality == PreviewQuality::Full || session_.draftResolution() == session_.previewSettings().resolution) {
+    if (!fullPending_) fullRequestedAt_ = std::chrono::steady_clock::now();
+    fullPending_ = true;
+  }
+}
+
+bool EditWindow::pollPreview() {
+  bool changed = false;
+  if (std::optional<PreviewFrame> frame = session_.takePreview()) {
+    showFrame(*frame);
+    changed = true;
+  }
+  // Idle after the take: the full frame is on screen, or a newer draft replaced it.
+  if (fullPending_ && !session_.previewBusy(PreviewQuality::Full)) fullPending_ = false;
+  // The note appears once a full frame has kept the user waiting a second, and counts up.
+  const bool waiting = fullPending_ && msSince(fullRequestedAt_) > 1000.0;
+  std::string note;
+  if (waiting) {
+    char text[96];
+    std::snprintf(text, sizeof text, "rendering the %d^3 preview... %.0f s", session_.previewSettings().resolution,
+                  std::floor(msSince(fullRequestedAt_) / 1000.0));
+    note = text;
+  }
+  const char* previous = previewProgress_->GetInput();
+  if (waiting != (previewProgress_->GetVisibility() != 0) || (previous ? note != previous : !note.empty())) {
+    previewProgress_->SetInput(note.c_str());
+    previewProgress_->SetVisibility(waiting);
+    changed = true;
+  }
+  return changed;
+}
+
+void EditWindow::settlePreview() {
+  if (std::optional<PreviewFrame> frame = session_.waitForPreview()) showFrame(*frame);
+  pollPreview();
+}
+
+void EditWindow::showFrame(const PreviewFrame& frame) {
+  if (!frame.error.empty()) {
+    showMessage("preview failed: " + frame.error, true);
+    return;
+  }
+  const Image& image = frame.image;
   const std::vector<unsigned char> rgb = toDisplayRgb8(image);
   previewImage_->SetDimensions(image.width, image.height, 1);
   previewImage_->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
@@ -251,16 +302,29 @@ void EditWindow::updatePreview() {
   preview_->ResetCamera();
   // Fill the view's height with the image (ResetCamera leaves a wide margin).
   preview_->GetActiveCamera()->SetParallelScale(0.5 * image.height);
-  char text[128];
-  std::snprintf(text, sizeof text, "preview %.0f ms", ms);
-  previewTiming_ = text;
+  shown_ = frame;
+  shown_->image = Image{};  // uploaded; the label needs the rest only
+  updatePreviewLabel();
+}
+
+void EditWindow::updatePreviewLabel() {
   // "vulkan (llvmpipe (LLVM 15.0.6, 256 bits))" would run off the view: keep the device.
   std::string backend = session_.previewBackendName();
   if (const std::size_t inner = backend.find(" (", backend.find('(') + 1); inner != std::string::npos)
     backend = backend.substr(0, inner) + ")";
-  previewLabel_->SetInput(("SSLPV preview (" + backend + ", " +
-                           std::to_string(session_.previewSettings().resolution) + "^3)  " + previewTiming_)
-                              .c_str());
+  char text[160];
+  if (!shown_) {
+    std::snprintf(text, sizeof text, "SSLPV preview (%s): rendering %d^3...", backend.c_str(),
+                  session_.previewSettings().resolution);
+  } else if (shown_->draft) {
+    std::snprintf(text, sizeof text, "SSLPV preview (%s): draft %d^3, %.0f ms; %d^3 when the stroke ends",
+                  backend.c_str(), shown_->resolution, shown_->renderMs, session_.previewSettings().resolution);
+  } else {
+    std::snprintf(text, sizeof text, "SSLPV preview (%s): %d^3, %.0f ms", backend.c_str(), shown_->resolution,
+                  shown_->renderMs);
+  }
+  previewLabelText_ = text;
+  previewLabel_->SetInput(previewLabelText_.c_str());
 }
 
 void EditWindow::updateStatus() {
@@ -312,7 +376,8 @@ void EditWindow::showMessage(const std::string& text, bool error) {
 }
 
 void EditWindow::refresh() {
-  if (session_.previewStale()) updatePreview();
+  if (session_.previewStale()) requestPreview(PreviewQuality::Full);
+  pollPreview();
   updateStatus();
   window_->Render();
 }
@@ -351,6 +416,7 @@ bool EditWindow::beginPaint(int x, int y) {
   }
   try {
     session_.beginStroke(controls_.brush());
+    slices_->holdRange(true);
     paintView_ = axis ? PaintView::Slice : PaintView::Surface;
     paintAxis_ = axis.value_or(0);
     continuePaint(x, y);
@@ -407,12 +473,17 @@ void EditWindow::continuePaint(int x, int y) {
     return;
   }
   updateSlices();
+  // One draft at a time: while one renders, the dabs wait for the timer to ask for the
+  // next, so the UI thread copies the set at most once per draft frame.
+  if (!session_.previewBusy(PreviewQuality::Draft)) requestPreview(PreviewQuality::Draft);
+  pollPreview();
   window_->Render();
 }
 
 void EditWindow::endPaint() {
   if (paintView_ == PaintView::None) return;
   paintView_ = PaintView::None;
+  slices_->holdRange(false);
   std::optional<StrokeResult> result;
   try {
     result = session_.endStroke();
@@ -425,7 +496,8 @@ void EditWindow::endPaint() {
 void EditWindow::afterChange(const std::optional<StrokeResult>& result, const char* what) {
   lastChange_ = std::chrono::steady_clock::now();
   updateSlices();
-  updatePreview();
+  requestPreview(PreviewQuality::Full);
+  pollPreview();
   if (result) {
     char text[160];
     std::snprintf(text, sizeof text, "%s: %zu voxels changed", what, result->voxelsChanged);
@@ -486,6 +558,10 @@ void EditWindow::maybeAutosave(bool strokeJustEnded) {
 }
 
 void EditWindow::onTimer() {
+  // A dab that came while the last draft rendered asks for the next one here.
+  if (painting() && session_.previewStale(PreviewQuality::Draft) && !session_.previewBusy(PreviewQuality::Draft))
+    requestPreview(PreviewQuality::Draft);
+  if (pollPreview()) window_->Render();
   if (painting()) return;
   maybeAutosave(false);
 }

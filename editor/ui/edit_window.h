@@ -44,8 +44,11 @@ class EditWindow {
   vtkRenderWindowInteractor* interactor() const;
   /// Shows a one-line message (errors in red) until the next message or key press.
   void showMessage(const std::string& text, bool error);
-  /// Re-renders the preview if stale and redraws everything.
+  /// Requests a preview of the current state if stale, shows a finished one, redraws.
   void refresh();
+  /// Waits for the preview frames requested so far and shows the newest (scripted runs:
+  /// before a screenshot).
+  void settlePreview();
   /// True once the user asked to quit (q / e), after any unsaved-work confirmation.
   bool quitRequested() const { return quit_; }
   /// The window is closing (window manager or quit): keeps unsaved work in the recovery file.
@@ -71,7 +74,13 @@ class EditWindow {
   enum class PaintView { None, Surface, Slice };
   void buildScene();
   void updateSlices();
-  void updatePreview();
+  /// Hands the current state to the preview's worker (never waits for the render).
+  void requestPreview(PreviewQuality quality);
+  /// Shows a finished frame if there is one; keeps the progress note current. True when
+  /// something on screen changed.
+  bool pollPreview();
+  void showFrame(const PreviewFrame& frame);
+  void updatePreviewLabel();
   void updateStatus();
   void afterChange(const std::optional<StrokeResult>& result, const char* what);
   void save(bool replaceConfirmed);
@@ -128,7 +137,12 @@ class EditWindow {
   std::string replaceArmed_;           ///< a path the user was asked about: writing it again replaces it
   bool saveArmed_ = false;             ///< Ctrl+S was refused pending confirmation: the next one replaces
   std::chrono::steady_clock::time_point lastChange_;
-  std::string previewTiming_;
+  // What the preview shows and what it waits for.
+  std::optional<PreviewFrame> shown_;  ///< the frame on screen (its image already uploaded)
+  bool fullPending_ = false;           ///< a full frame was requested and has not arrived
+  std::chrono::steady_clock::time_point fullRequestedAt_;
+  std::string previewLabelText_;
+  vtkSmartPointer<vtkTextActor> previewProgress_;  ///< "rendering ..." over the preview
 };
 
 }  // namespace sslpv

@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace sslpv {
 namespace {
@@ -152,12 +153,7 @@ void SliceViews::update(const MaterialField& field, const std::string& channel, 
         }
     image->Modified();
   }
-  // A uniform slice still needs a visible legend range.
-  if (!(hi > lo)) {
-    const double pad = std::max(std::abs(lo) * 0.05, 1e-3);
-    lo -= pad;
-    hi += pad;
-  }
+  std::tie(lo, hi) = range_.fit(channel, lo, hi);
   colors_->RemoveAllPoints();
   for (int s = 0; s < 5; ++s)
     colors_->AddRGBPoint(lo + (hi - lo) * s / 4.0, kViridis[s][0], kViridis[s][1], kViridis[s][2]);

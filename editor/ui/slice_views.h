@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "editor/legend_range.h"
 #include "volume/material_set.h"
 #include "volume/mesh.h"
 
@@ -35,8 +36,10 @@ class SliceViews {
   ~SliceViews();
 
   /// Resamples the three slices of `channel` ("sigma_t", "sigma_s", "g", "albedo"; σ shown
-  /// as the mean of RGB per scene unit) and rescales the legend to their range.
+  /// as the mean of RGB per scene unit) and rescales the legend to their range (unless held).
   void update(const MaterialField& field, const std::string& channel, const std::string& units);
+  /// During a stroke: update() keeps the colour range (editor/legend_range.h).
+  void holdRange(bool on) { range_.hold(on); }
 
   /// The slice axis that `renderer` shows, if it is one of the slice views.
   std::optional<int> axisOf(const vtkRenderer* renderer) const;
@@ -62,6 +65,7 @@ class SliceViews {
   std::array<vtkSmartPointer<vtkActor>, 3> outlines_;
   vtkSmartPointer<vtkColorTransferFunction> colors_;
   vtkSmartPointer<vtkScalarBarActor> legend_;
+  LegendRange range_;
 };
 
 }  // namespace sslpv
