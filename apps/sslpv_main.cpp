@@ -137,9 +137,7 @@ int runRender(const RenderArgs& args) {
         throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
       autoNote = std::string("--backend auto: no usable Vulkan device (") + e.what() + "); the CPU backend rendered";
     }
-    // Vulkan on the CPU (Mesa lavapipe) shares the CPU backend's cores with a slower
-    // code path: the CPU backend's frame is several times faster there (docs/performance.md).
-    if (device && args.backend == "auto" && device->properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {
+    if (device && args.backend == "auto" && device->runsOnCpu()) {
       autoNote = "--backend auto: " + device->name() +
                  " is Vulkan on the CPU; the CPU backend is faster here (--backend vulkan to use it)";
       device.reset();

@@ -85,7 +85,7 @@ class Backend final : public FrameRenderer {
 /// stays on the CPU backend after it fails (a device without float atomics, say).
 RendererFactory makeFactory(const std::string& backend, const gpu::VulkanDevice& device) {
   auto vulkanFailed =
-      std::make_shared<bool>(backend == "auto" && device.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
+      std::make_shared<bool>(backend == "auto" && device.runsOnCpu());
   return [backend, &device, vulkanFailed](const Scene& scene) -> std::unique_ptr<FrameRenderer> {
     if (backend == "cpu" || (backend == "auto" && *vulkanFailed))
       return std::make_unique<Backend<CpuRenderer>>(scene);

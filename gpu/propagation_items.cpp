@@ -63,7 +63,7 @@ std::vector<unsigned char> occupiedSlabs(const GridFrame& frame, const StepFacto
 /// Threads that run a dispatch's workgroups: lavapipe's compute pool has LP_NUM_THREADS
 /// or one per core; a GPU has far more lanes than items, so 1 disables balancing.
 std::size_t workerThreads(const VulkanDevice& device) {
-  if (device.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return 1;
+  if (!device.runsOnCpu()) return 1;
   if (const char* env = std::getenv("LP_NUM_THREADS")) return std::max(1, std::atoi(env));
   return std::max(1u, std::thread::hardware_concurrency());
 }
