@@ -70,6 +70,7 @@ class CpuRenderer {
   PropagationWarmStart warm_;
   CoarseStart coarse_;
   std::unique_ptr<ShadingSurface> surface_;  ///< null: the camera or the geometry changed
+  bool viewShadedOnce_ = false;               ///< the current view was shaded before: keep it
   bool coarseStartEnabled_ = true;
   RenderReport last_;
   Image image_;

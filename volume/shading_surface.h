@@ -31,13 +31,16 @@ struct ShadingSurface {
     std::array<float, 8> weights{};
     SingleScatteringGeometry single;  ///< filled where `refracts`
   };
-  std::vector<Pixel> pixels;  ///< the pixels that see a lit cell, in image order
+  /// Per image row, the pixels that see a lit cell, left to right.
+  std::vector<std::vector<Pixel>> rows;
 };
 
 /// Casts the camera's rays and finds, per pixel, what shadeSurface reads.
 ShadingSurface traceShadingSurface(const Camera& camera, const RayScene& rays, const MaterialGrid& material, double ior);
 
-/// shadeImage (lpv_stages.h) on a traced surface: the same image, bit for bit.
+/// shadeImage (lpv_stages.h) on a traced surface: the same image, bit for bit. shadeImage
+/// itself traces and shades row by row without keeping the surface, for frames whose view
+/// is not reused.
 Image shadeSurface(const ShadingSurface& surface, const MaterialGrid& material, const ShGrid& accumulated, double ior,
                    const std::array<std::vector<float>, 3>* exitGain = nullptr,
                    const std::array<std::vector<float>, 3>* reducedAlbedo = nullptr,
