@@ -6,10 +6,14 @@
 // fit leaves of real shading. Prints a table; not a test.
 //
 //   band_metric [--grid 32,64] [--material skin1] [--size 128] [--spp 32] [--scenes a.json,b.json]
+//               [--cache DIR] [--builtin 0]
 //
-// --spp 0 skips the references. Renders: CPU backend, calibrated, --steps auto, a cold
+// --spp 0 skips the references; --cache keeps them (NAME-SIZE-sppN.exr and its
+// .stderr.exr, seed 0) and reuses them (an image without its .stderr.exr too: then the
+// noise column is unknown, "-"). --builtin 0 measures only the --scenes files. Renders: CPU backend, calibrated, --steps auto, a cold
 // first frame (a new renderer per row).
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -17,6 +21,7 @@
 #include "bench/band_scenes.h"
 #include "volume/cpu_renderer.h"
 #include "volume/grid_band_samples.h"
+#include "volume/image_io.h"
 #include "volume/image_metrics.h"
 #include "volume/reference_tracer.h"
 
@@ -40,12 +45,38 @@ void printRow(const std::string& name, const char* kind, int grid, double ms, co
   std::fflush(stdout);
 }
 
+/// The scene's path-traced image, from `cache` when it holds one of this size and spp
+/// (the scene's name says what it is: a changed scene needs a fresh cache).
+ReferenceResult reference(const Named& named, int spp, int size, const std::string& cache) {
+  const std::filesystem::path file =
+      cache.empty() ? std::filesystem::path() : std::filesystem::path(cache) / (named.name + "-" + std::to_string(size) + "-spp" + std::to_string(spp) + ".exr");
+  std::filesystem::path errors = file;
+  errors.replace_extension(".stderr.exr");
+  ReferenceResult truth;
+  if (!cache.empty() && std::filesystem::exists(file)) {
+    truth.radiance = readImage(file);
+    if (std::filesystem::exists(errors)) truth.standardError = readImage(errors);
+    return truth;
+  }
+  ReferenceOptions options;
+  options.spp = spp;
+  truth = ReferenceTracer(named.scene).render(options);
+  if (!cache.empty()) {
+    std::filesystem::create_directories(cache);
+    writeImage(truth.radiance, file);
+    writeImage(truth.standardError, errors);
+  }
+  return truth;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace sslpv::bench;
-  const Flags flags(argc, argv, {"grid", "material", "size", "spp", "scenes"},
-                    "band_metric [--grid 32,64] [--material skin1] [--size 128] [--spp 32] [--scenes a.json,b.json]");
+  const char* usage =
+      "band_metric [--grid 32,64] [--material skin1] [--size 128] [--spp 32] [--scenes a.json,b.json] [--cache DIR] "
+      "[--builtin 0]";
+  const Flags flags(argc, argv, {"grid", "material", "size", "spp", "scenes", "cache", "builtin"}, usage);
   if (!flags.ok()) return 2;
   const MeasuredMaterial* material = findMeasuredMaterial(flags.text("material", "skin1"));
   if (material == nullptr) {
@@ -61,9 +92,11 @@ int main(int argc, char** argv) {
   }
   std::vector<Named> scenes;
   const std::string m(material->name);
+  if (flags.integer("builtin", 1) != 0) {
   for (double yaw : {0.0, 7.0, 12.0, 20.0}) scenes.push_back({m + "_box_yaw" + std::to_string(int(yaw)), bandBox(*material, yaw, 0.0, size)});
   scenes.push_back({m + "_box_yaw12_tilt8", bandBox(*material, 12.0, 8.0, size)});
   scenes.push_back({m + "_sphere", bandSphere(*material, size)});
+  }
   try {
     for (const std::string& file : flags.names("scenes", {})) {
       Scene scene = loadScene(file);
@@ -83,11 +116,7 @@ int main(int argc, char** argv) {
               "band %", "noise %", "pixels");
   for (const Named& named : scenes) {
     ReferenceResult truth;
-    if (spp > 0) {
-      ReferenceOptions options;
-      options.spp = spp;
-      truth = ReferenceTracer(named.scene).render(options);
-    }
+    if (spp > 0) truth = reference(named, spp, size, flags.text("cache", ""));
     for (int grid : grids) {
       const std::vector<GridBandSample> samples = gridBandSamples(named.scene, grid);
       CpuRenderer renderer(named.scene);
@@ -95,9 +124,11 @@ int main(int argc, char** argv) {
       const Image lpv = renderer.render(calibratedAuto(grid));
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       printRow(named.name, "sslpv", grid, ms, gridBandAmplitude(lpv, samples), false);
-      if (spp > 0)
-        printRow(named.name, "reference", grid, 1000.0 * truth.seconds, gridBandAmplitude(truth.radiance, samples, &truth.standardError),
-                 true);
+      if (spp > 0) {
+        const bool withNoise = truth.standardError.width == truth.radiance.width;
+        printRow(named.name, "reference", grid, 1000.0 * truth.seconds,
+                 gridBandAmplitude(truth.radiance, samples, withNoise ? &truth.standardError : nullptr), withNoise);
+      }
     }
   }
   return 0;

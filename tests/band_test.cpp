@@ -101,14 +101,17 @@ double renderedBands(double yawDeg, double tiltDeg, int grid) {
 }
 
 TEST(GridBands, ATurnedBoxBandsNoMoreThanWhenMeasured) {
-  // Measured 2026-12-04 (bench/band_metric, the same scenes): yaw 7° 2.52 % at 32³ and
-  // 1.37 % at 64³, yaw 12° 1.76 % at 32³. The margin, ×1.15, lets a change elsewhere in
-  // the scheme move the bands a little without failing, and fails on any change that brings
-  // back a clearly stronger band. The path-traced references of the same scenes read
-  // 0.3-0.6 % (their noise and what the smooth fit leaves): the metric's floor.
-  EXPECT_LT(renderedBands(7.0, 0.0, 32), 1.15 * 0.0252);
-  EXPECT_LT(renderedBands(12.0, 0.0, 32), 1.15 * 0.0176);
-  EXPECT_LT(renderedBands(7.0, 0.0, 64), 1.15 * 0.0137);
+  // Measured 2026-12-04 (bench/band_metric, the same scenes, 128²): yaw 12° 1.74 % at 32³
+  // and 1.29 % at 64³, yaw 7° 1.39 % at 64³. The 128-spp path-traced references of the
+  // same scenes, binned by the same grids' phases, read 0.65-0.72 % (their noise alone
+  // predicts 0.43-0.48 %, the rest is what the smooth fit leaves of real shading): the
+  // metric's floor, so these bands are real, 2-2.7x the floor. (Yaw 7° at 32³, 2.53 %, is
+  // left out: there the stripes cross a face only ~3 times and the reference already
+  // reads 1.56 %.) The margin, ×1.15, lets a change elsewhere in the scheme move the
+  // bands a little and fails on one that brings back clearly stronger bands.
+  EXPECT_LT(renderedBands(12.0, 0.0, 32), 1.15 * 0.0174);
+  EXPECT_LT(renderedBands(12.0, 0.0, 64), 1.15 * 0.0129);
+  EXPECT_LT(renderedBands(7.0, 0.0, 64), 1.15 * 0.0139);
 }
 
 }  // namespace
