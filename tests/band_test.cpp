@@ -1,7 +1,8 @@
 // Grid-layer bands: the band metric (gridBandAmplitude, volume/image_metrics.h) reads near
 // zero on a smooth image and reads the amplitude of bands injected at the grid's cell
-// layers; and the CPU renders of a homogeneous box turned against the grid do not band more
-// than they did when the metric was introduced (docs/accuracy.md "Grid-layer bands").
+// layers; and the CPU renders of a homogeneous box turned against the grid and of a tilted
+// layered slab do not band more than they did when the metric was introduced
+// (docs/accuracy.md "Grid-layer bands").
 #include <gtest/gtest.h>
 
 #include <cmath>
