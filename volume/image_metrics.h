@@ -153,14 +153,16 @@ constexpr double kGridBandPeriod = 2.0;
 /// The amplitude of the image's luminance pattern locked to the grid's cell layers. The
 /// pixels are split into patches of similar normal (within ~26°), each patch loses a rim
 /// of kGridBandRim pixels (silhouette, edges: real, sharp changes no smooth fit follows),
-/// log-luminance is fitted by a quadratic in the patch's tangent plane, and each pixel's
-/// relative deviation from the fit is binned by its read point's phase along each grid
-/// axis, measured inward (from the cell face the outward normal points through), over
-/// kGridBandPeriod cells. A smooth image reads near zero however it is lit; bands that
-/// follow the cell layers read their RMS amplitude. `standardError` (a path tracer's,
-/// same size as `image`) adds the expected noise contribution. Patches under 64 pixels are
-/// left out. Preconditions (std::invalid_argument): sample pixels inside the image,
-/// `standardError` of the same size.
+/// and each pixel gets, per grid axis, a phase over kGridBandPeriod cells: its layer's
+/// parity plus its read point's depth below the cell face the outward normal points
+/// through. Per axis, log-luminance is fitted jointly by a quadratic in each patch's
+/// tangent plane (the smooth lighting) and one offset per phase bin (the bands), so that
+/// neither takes up the other; the axis reads the pixel-weighted RMS of the offsets. A
+/// smooth image reads near zero however it is lit; bands that follow the cell layers read
+/// their RMS amplitude. Texture that happens to line up with the cell layers counts too.
+/// `standardError` (a path tracer's, same size as `image`) adds the expected noise
+/// contribution. Patches under 64 pixels are left out. Preconditions
+/// (std::invalid_argument): sample pixels inside the image, `standardError` of the same size.
 constexpr int kGridBandRim = 2;
 GridBandAmplitude gridBandAmplitude(const Image& image, const std::vector<GridBandSample>& samples,
                                     const Image* standardError = nullptr);
