@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -295,6 +296,191 @@ double maxRelativeDifference(const Image& a, const Image& b) {
       worst = std::max(worst, std::isfinite(d) ? d : INFINITY);
     }
   return worst;
+}
+
+namespace {
+
+/// Least squares for a few unknowns: solves the normal equations A x = b (k×k, row-major)
+/// by Gaussian elimination with partial pivoting; false when A is singular.
+bool solveNormalEquations(std::vector<double> a, std::vector<double> b, std::vector<double>& x) {
+  const std::size_t k = b.size();
+  for (std::size_t col = 0; col < k; ++col) {
+    std::size_t pivot = col;
+    for (std::size_t r = col + 1; r < k; ++r)
+      if (std::abs(a[r * k + col]) > std::abs(a[pivot * k + col])) pivot = r;
+    if (!(std::abs(a[pivot * k + col]) > 1e-12 * std::abs(a[0]))) return false;
+    for (std::size_t c = 0; c < k; ++c) std::swap(a[col * k + c], a[pivot * k + c]);
+    std::swap(b[col], b[pivot]);
+    for (std::size_t r = col + 1; r < k; ++r) {
+      const double f = a[r * k + col] / a[col * k + col];
+      for (std::size_t c = col; c < k; ++c) a[r * k + c] -= f * a[col * k + c];
+      b[r] -= f * b[col];
+    }
+  }
+  x.assign(k, 0.0);
+  for (std::size_t r = k; r-- > 0;) {
+    double sum = b[r];
+    for (std::size_t c = r + 1; c < k; ++c) sum -= a[r * k + c] * x[c];
+    x[r] = sum / a[r * k + r];
+  }
+  return true;
+}
+
+constexpr std::size_t kFitTerms = 6;  ///< 1, u, v, u², uv, v²
+
+std::array<double, kFitTerms> quadraticTerms(double u, double v) { return {1.0, u, v, u * u, u * v, v * v}; }
+
+/// Per phase bin: pixels and their summed relative variance.
+struct PhaseBin {
+  std::size_t count = 0;
+  double variance = 0.0;
+};
+
+}  // namespace
+
+GridBandAmplitude gridBandAmplitude(const Image& image, const std::vector<GridBandSample>& samples,
+                                    const Image* standardError) {
+  const int width = image.width, height = image.height;
+  const std::size_t pixelCount = std::size_t(width) * std::size_t(height);
+  if (standardError) requireSameSize(image, *standardError, "gridBandAmplitude");
+  // Patches of similar normal: a cube's faces, a sphere's caps. One smooth fit per patch
+  // follows its lighting; a fit across an edge would not.
+  constexpr double kSamePatch = 0.9;
+  constexpr std::size_t kNone = std::size_t(-1);
+  std::vector<int> patchOf(pixelCount, -1);
+  std::vector<std::size_t> sampleOf(pixelCount, kNone);
+  std::vector<glm::dvec3> seeds;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const GridBandSample& s = samples[k];
+    if (s.pixel >= pixelCount) throw std::invalid_argument("gridBandAmplitude: a sample's pixel is outside the image");
+    if (!(luminance(image.pixels[s.pixel]) > 0.0)) continue;  // unlit (or not finite): nothing to fit
+    int patch = -1;
+    for (std::size_t j = 0; j < seeds.size() && patch < 0; ++j)
+      if (glm::dot(seeds[j], s.normal) >= kSamePatch) patch = int(j);
+    if (patch < 0) {
+      patch = int(seeds.size());
+      seeds.push_back(s.normal);
+    }
+    patchOf[s.pixel] = patch;
+    sampleOf[s.pixel] = k;
+  }
+  // Each patch without its rim.
+  std::vector<std::vector<std::size_t>> members(seeds.size());
+  for (int y = kGridBandRim; y < height - kGridBandRim; ++y)
+    for (int x = kGridBandRim; x < width - kGridBandRim; ++x) {
+      const std::size_t at = std::size_t(y) * std::size_t(width) + std::size_t(x);
+      const int patch = patchOf[at];
+      if (patch < 0) continue;
+      bool interior = true;
+      for (int dy = -kGridBandRim; dy <= kGridBandRim && interior; ++dy)
+        for (int dx = -kGridBandRim; dx <= kGridBandRim && interior; ++dx)
+          interior = patchOf[std::size_t(y + dy) * std::size_t(width) + std::size_t(x + dx)] == patch;
+      if (interior) members[std::size_t(patch)].push_back(sampleOf[at]);
+    }
+  // Every pixel that takes part: its patch, its fit terms, log-luminance and relative variance.
+  struct Member {
+    std::size_t sample = 0, patch = 0;
+    std::array<double, kFitTerms> terms{};
+    double logY = 0.0, variance = 0.0;
+  };
+  std::vector<Member> used;
+  std::size_t patches = 0;
+  for (const std::vector<std::size_t>& patch : members) {
+    if (patch.size() < 64) continue;
+    glm::dvec3 normal(0.0), centre(0.0);
+    for (std::size_t k : patch) {
+      normal += samples[k].normal;
+      centre += samples[k].position;
+    }
+    normal = glm::normalize(normal);
+    centre /= double(patch.size());
+    const glm::dvec3 t1 =
+        glm::normalize(glm::cross(normal, std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+    const glm::dvec3 t2 = glm::cross(normal, t1);
+    double extent = 0.0;
+    for (std::size_t k : patch)
+      extent = std::max({extent, std::abs(glm::dot(samples[k].position - centre, t1)),
+                         std::abs(glm::dot(samples[k].position - centre, t2))});
+    if (!(extent > 0.0)) continue;
+    for (std::size_t k : patch) {
+      const GridBandSample& s = samples[k];
+      const glm::dvec3 d = s.position - centre;
+      Member m;
+      m.sample = k;
+      m.patch = patches;
+      m.terms = quadraticTerms(glm::dot(d, t1) / extent, glm::dot(d, t2) / extent);
+      const double y = luminance(image.pixels[s.pixel]);
+      m.logY = std::log(y);
+      if (standardError) {
+        // Channels traced independently: the luminance's variance is the weighted sum.
+        const glm::dvec3 se(standardError->pixels[s.pixel]);
+        m.variance =
+            (0.2126 * 0.2126 * se.x * se.x + 0.7152 * 0.7152 * se.y * se.y + 0.0722 * 0.0722 * se.z * se.z) / (y * y);
+      }
+      used.push_back(m);
+    }
+    ++patches;
+  }
+  GridBandAmplitude out;
+  out.pixels = used.size();
+  if (used.empty()) return out;
+  const double n = double(used.size());
+  // Per axis one joint least-squares fit of log-luminance: a quadratic per patch (the
+  // smooth lighting) plus one offset per phase bin (the bands). Fitted jointly, a patch's
+  // trend cannot take up bands that cross it only a few times, nor the bands its trend.
+  // A tiny ridge on the offsets settles what no pixel decides (a phase seen by one flat,
+  // grid-aligned patch only) at zero.
+  const std::size_t unknowns = kFitTerms * patches + std::size_t(kGridBandBins);
+  const std::size_t firstBin = kFitTerms * patches;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<std::size_t> binOf(used.size());
+    std::vector<double> ata(unknowns * unknowns, 0.0), atb(unknowns, 0.0), solution;
+    std::array<PhaseBin, kGridBandBins> bins{};
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      const Member& m = used[i];
+      const GridBandSample& s = samples[m.sample];
+      // Within a cell: the depth below the face the outward normal points through, so that
+      // opposite faces (and both sides of a sphere) put the same phase in the same bin;
+      // across cells: the layer's parity as it is (a reflected phase would swap odd and
+      // even layers between opposite faces).
+      const double layer = std::floor(s.grid[a]), within = s.grid[a] - layer;
+      const double parity = layer - 2.0 * std::floor(0.5 * layer);
+      const double phase = (parity + (s.normal[a] > 0.0 ? 1.0 - within : within)) / kGridBandPeriod;
+      binOf[i] = std::size_t(std::clamp(int(phase * kGridBandBins), 0, kGridBandBins - 1));
+      PhaseBin& bin = bins[binOf[i]];
+      ++bin.count;
+      bin.variance += m.variance;
+      std::array<std::size_t, kFitTerms + 1> at{};
+      std::array<double, kFitTerms + 1> value{};
+      for (std::size_t t = 0; t < kFitTerms; ++t) {
+        at[t] = kFitTerms * m.patch + t;
+        value[t] = m.terms[t];
+      }
+      at[kFitTerms] = firstBin + binOf[i];
+      value[kFitTerms] = 1.0;
+      for (std::size_t r = 0; r <= kFitTerms; ++r) {
+        atb[at[r]] += value[r] * m.logY;
+        for (std::size_t c = 0; c <= kFitTerms; ++c) ata[at[r] * unknowns + at[c]] += value[r] * value[c];
+      }
+    }
+    for (int b = 0; b < kGridBandBins; ++b) ata[(firstBin + std::size_t(b)) * (unknowns + 1)] += 1e-3;
+    if (!solveNormalEquations(ata, atb, solution)) continue;
+    double mean = 0.0;
+    for (int b = 0; b < kGridBandBins; ++b) mean += double(bins[std::size_t(b)].count) * solution[firstBin + std::size_t(b)];
+    mean /= n;
+    double spread = 0.0, noise = 0.0;
+    for (int b = 0; b < kGridBandBins; ++b) {
+      const PhaseBin& bin = bins[std::size_t(b)];
+      if (bin.count == 0) continue;
+      const double offset = std::exp(solution[firstBin + std::size_t(b)] - mean) - 1.0;
+      spread += double(bin.count) * offset * offset;
+      noise += bin.variance / double(bin.count);
+    }
+    out.axis[a] = std::sqrt(spread / n);
+    out.noise[a] = std::sqrt(noise / n);
+  }
+  out.amplitude = std::max({out.axis.x, out.axis.y, out.axis.z});
+  return out;
 }
 
 }  // namespace sslpv

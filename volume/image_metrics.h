@@ -124,6 +124,49 @@ ImageMetrics computeImageMetrics(const Image& a, const Image& b, const PixelMask
 constexpr float kRatioMapBelowFloor = 0.25f;
 Image ratioMap(const Image& a, const Image& b, const PixelMask& mask, double floor, int scale);
 
+/// Grid-layer bands (docs/accuracy.md "Grid-layer bands"): one surface pixel as the
+/// shading reads the grid. `grid` holds the continuous grid coordinates (cell (i,j,k)
+/// spans [i, i+1) per axis) of the point the shading reads, half a cell inside the
+/// surface; `normal` the outward unit normal; `position` the world hit point, over which
+/// the smooth part of the image is fitted.
+struct GridBandSample {
+  std::uint32_t pixel = 0;  ///< y · width + x
+  glm::dvec3 grid{0.0}, normal{0.0}, position{0.0};
+};
+
+struct GridBandAmplitude {
+  /// Per grid axis: the RMS over the phase bins (pixel-weighted) of the mean relative
+  /// deviation of luminance from its smooth fit, a fraction (0.01 = 1 %).
+  glm::dvec3 axis{0.0};
+  double amplitude = 0.0;  ///< the largest of `axis`
+  /// Per axis: what the given per-pixel standard error alone adds to `axis` in expectation
+  /// (zero without one): the noise floor of a Monte Carlo image.
+  glm::dvec3 noise{0.0};
+  std::size_t pixels = 0;  ///< pixels that took part (inside a patch, away from its rim)
+};
+
+/// Phase bins over kGridBandPeriod cells: a pattern locked to the cell phase (period 1)
+/// and one alternating between layers (period 2) both show.
+constexpr int kGridBandBins = 16;
+constexpr double kGridBandPeriod = 2.0;
+
+/// The amplitude of the image's luminance pattern locked to the grid's cell layers. The
+/// pixels are split into patches of similar normal (within ~26°), each patch loses a rim
+/// of kGridBandRim pixels (silhouette, edges: real, sharp changes no smooth fit follows),
+/// and each pixel gets, per grid axis, a phase over kGridBandPeriod cells: its layer's
+/// parity plus its read point's depth below the cell face the outward normal points
+/// through. Per axis, log-luminance is fitted jointly by a quadratic in each patch's
+/// tangent plane (the smooth lighting) and one offset per phase bin (the bands), so that
+/// neither takes up the other; the axis reads the pixel-weighted RMS of the offsets. A
+/// smooth image reads near zero however it is lit; bands that follow the cell layers read
+/// their RMS amplitude. Texture that happens to line up with the cell layers counts too.
+/// `standardError` (a path tracer's, same size as `image`) adds the expected noise
+/// contribution. Patches under 64 pixels are left out. Preconditions
+/// (std::invalid_argument): sample pixels inside the image, `standardError` of the same size.
+constexpr int kGridBandRim = 2;
+GridBandAmplitude gridBandAmplitude(const Image& image, const std::vector<GridBandSample>& samples,
+                                    const Image* standardError = nullptr);
+
 /// Where the numbers came from, for the JSON record.
 struct CompareSource {
   std::string a, b;          ///< file names
