@@ -178,9 +178,12 @@ int runRender(const RenderArgs& args) {
     printWarning(args.scene + ": the scene has no \"deformers\": every time renders the same image");
 
   std::string autoNote;
+#ifdef SSLPV_HAVE_VULKAN
+  // Declared before the renderer, so that it outlives it.
+  std::unique_ptr<gpu::VulkanDevice> device;
+#endif
   std::unique_ptr<FrameRenderer> renderer;
 #ifdef SSLPV_HAVE_VULKAN
-  std::unique_ptr<gpu::VulkanDevice> device;
   if (args.backend != "cpu") {
     try {
       device = std::make_unique<gpu::VulkanDevice>();

@@ -46,6 +46,16 @@ TEST_F(DeformCli, FramesWriteOneDistinctFilePerFrameWithAProgressLineEach) {
   EXPECT_NE(r.stderrText.find("render: frame 3/3 (t = 1)"), std::string::npos) << r.stderrText;
 }
 
+TEST_F(DeformCli, VulkanFramesToo) {
+  writeScene(bendingScene());
+  const RunResult r =
+      run({"render", scenePath().string(), "--frames", "0:24:24", "-o", (dir_ / "v%d.png").string(), "--backend",
+           "vulkan"});
+  if (r.exitCode == 3) GTEST_SKIP() << "SKIPPED, no Vulkan backend here: " << r.stderrText;
+  ASSERT_EQ(r.exitCode, 0) << r.stderrText;
+  EXPECT_NE(readImage(dir_ / "v0.png").pixels, readImage(dir_ / "v24.png").pixels);
+}
+
 TEST_F(DeformCli, TimeRendersThePoseOfThatFrame) {
   writeScene(bendingScene());
   const auto frame = dir_ / "t.png";
