@@ -20,6 +20,7 @@
 #include "apps/cmd_bench_error.h"
 #include "apps/cmd_compare.h"
 #include "apps/cmd_paint.h"
+#include "apps/cmd_render_frames.h"
 #include "apps/cmd_export.h"
 #include "apps/cmd_edit.h"
 #include "apps/cmd_inspect.h"
@@ -36,6 +37,7 @@
 #include "volume/image_io.h"
 #include "volume/input_ranges.h"
 #include "volume/material_set.h"
+#include "volume/mesh.h"
 #include "volume/reference_tracer.h"
 #include "volume/scene.h"
 #include "volume/scene_checks.h"
@@ -93,11 +95,48 @@ void warnAboutScene(const sslpv::Scene& scene) {
 }
 
 struct RenderArgs {
-  std::string scene, output, backend = "auto", steps, scheme, size;
+  std::string scene, output, backend = "auto", steps, scheme, size, frames;
   std::optional<int> grid, shadowMap;
+  std::optional<double> time;
+  double fps = 24.0;
   bool timings = false;
   float exposure = 1.0f;
 };
+
+/// One renderer of either backend, kept across the frames of a sequence so that each
+/// frame re-runs only what the new pose changes.
+class FrameRenderer {
+ public:
+  virtual ~FrameRenderer() = default;
+  virtual void setTime(double t) = 0;
+  virtual sslpv::Image render(const sslpv::LpvSettings& settings, sslpv::RenderReport& report) = 0;
+};
+
+class CpuFrameRenderer : public FrameRenderer {
+ public:
+  explicit CpuFrameRenderer(const sslpv::Scene& scene) : renderer_(scene) {}
+  void setTime(double t) override { renderer_.setTime(t); }
+  sslpv::Image render(const sslpv::LpvSettings& settings, sslpv::RenderReport& report) override {
+    return renderer_.render(settings, &report);
+  }
+
+ private:
+  sslpv::CpuRenderer renderer_;
+};
+
+#ifdef SSLPV_HAVE_VULKAN
+class VulkanFrameRenderer : public FrameRenderer {
+ public:
+  VulkanFrameRenderer(const sslpv::Scene& scene, const sslpv::gpu::VulkanDevice& device) : renderer_(scene, device) {}
+  void setTime(double t) override { renderer_.setTime(t); }
+  sslpv::Image render(const sslpv::LpvSettings& settings, sslpv::RenderReport& report) override {
+    return renderer_.render(settings, &report);
+  }
+
+ private:
+  sslpv::gpu::VulkanRenderer renderer_;
+};
+#endif
 
 int runRender(const RenderArgs& args) {
   using namespace sslpv;
@@ -106,28 +145,45 @@ int runRender(const RenderArgs& args) {
     throw InputError("--backend: unknown backend '" + args.backend + "' (auto, vulkan, cpu)");
   if (!isSupportedImageExtension(args.output))
     throw InputError(args.output + ": unsupported output format (use .png, .pfm or .exr)");
-  requireWritableOutput(args.output);
   // Checked before the render: a bad flag should not cost one.
   if (!(args.exposure >= kMinExposure && args.exposure <= kMaxExposure))
     throw InputError("--exposure: must be in [" + formatNumber(kMinExposure) + ", " + formatNumber(kMaxExposure) +
                      "], got " + formatNumber(args.exposure));
+  if (!(args.fps > 0.0 && args.fps <= 1e6))
+    throw InputError("--fps: must be in (0, 1000000], got " + formatNumber(args.fps));
+  if (args.time && !args.frames.empty()) throw InputError("--time and --frames: give one, not both");
+
+  // One entry per frame: the time and the file. A single render is frame "time".
+  std::vector<std::pair<double, std::string>> frames;
+  if (!args.frames.empty()) {
+    const FrameRange range = parseFrameRange(args.frames);
+    requireFramePattern(args.output);
+    for (int f : range.frames()) frames.emplace_back(double(f) / args.fps, framePath(args.output, f));
+  } else {
+    frames.emplace_back(args.time.value_or(0.0), args.output);
+  }
+  for (const auto& frame : frames) requireWritableOutput(frame.second);
 
   Camera sized;
   if (!args.size.empty()) sslpv::applySizeFlag(args.size, sized);
 
-  Scene scene = loadScene(args.scene);
+  Scene scene = sceneAtTime(loadScene(args.scene), frames.front().first);
   const LpvSettings settings = applyLpvFlags(scene.lpv, {args.grid, args.steps, args.shadowMap, args.scheme});
   if (!args.size.empty()) {
     scene.camera.width = sized.width;
     scene.camera.height = sized.height;
   }
   warnAboutScene(scene);
+  if (scene.deformers.empty() && (args.time || frames.size() > 1))
+    printWarning(args.scene + ": the scene has no \"deformers\": every time renders the same image");
 
-  RenderReport report;
-  Image image;
   std::string autoNote;
 #ifdef SSLPV_HAVE_VULKAN
+  // Declared before the renderer, so that it outlives it.
   std::unique_ptr<gpu::VulkanDevice> device;
+#endif
+  std::unique_ptr<FrameRenderer> renderer;
+#ifdef SSLPV_HAVE_VULKAN
   if (args.backend != "cpu") {
     try {
       device = std::make_unique<gpu::VulkanDevice>();
@@ -145,36 +201,65 @@ int runRender(const RenderArgs& args) {
   }
   if (device) {
     try {
-      image = gpu::VulkanRenderer(scene, *device).render(settings, &report);
+      renderer = std::make_unique<VulkanFrameRenderer>(scene, *device);
     } catch (const GpuError& e) {
       throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
     }
-  } else {
-    image = CpuRenderer(scene).render(settings, &report);
   }
 #else
   if (args.backend == "vulkan")
     throw ResourceError("--backend vulkan: this sslpv was built without Vulkan (--backend cpu needs no GPU)");
-  image = CpuRenderer(scene).render(settings, &report);
 #endif
-  warnIfOpticallyThin(report, args.scene);
-  if (report.propagation.capped)
-    std::cerr << "sslpv: warning: " << args.scene << ": --steps auto stopped at its cap of "
-              << report.propagation.stepsRun << " steps before converging; the image may be off (fixed --steps N runs N)"
-              << std::endl;
-  requireFiniteImage(image, args.scene, report.backend);
-  warnIfBlack(image, args.scene);
-  writeImage(image, args.output, args.exposure);
-  if (args.timings) {
-    if (!autoNote.empty()) std::cout << autoNote << "\n";
-    std::cout << formatTimings(report);
+  if (!renderer) renderer = std::make_unique<CpuFrameRenderer>(scene);
+  if (!scene.deformers.empty() && frames.size() > 1) {
+    // Every pose is checked before the first file is written: a fold at frame 40 must
+    // not leave 39 frames behind. The renderer has checked the mesh itself.
+    const TriangleMesh rest = loadMesh(scene.mesh, Transform{}, false);
+    for (const auto& frame : frames)
+      deformPositions(rest.positions, DeformationPose(scene.deformers, frame.first), scene.file.string(),
+                      frame.first);
   }
-  printWrote(args.output, imageSizeText(image), start);
+
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const auto frameStart = CliClock::now();
+    RenderReport report;
+    Image image;
+#ifdef SSLPV_HAVE_VULKAN
+    try {
+#endif
+      if (i > 0) renderer->setTime(frames[i].first);
+      image = renderer->render(settings, report);
+#ifdef SSLPV_HAVE_VULKAN
+    } catch (const GpuError& e) {
+      throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
+    }
+#endif
+    if (i == 0) warnIfOpticallyThin(report, args.scene);
+    if (report.propagation.capped)
+      std::cerr << "sslpv: warning: " << args.scene << ": --steps auto stopped at its cap of "
+                << report.propagation.stepsRun
+                << " steps before converging; the image may be off (fixed --steps N runs N)" << std::endl;
+    requireFiniteImage(image, args.scene, report.backend);
+    if (frames.size() == 1) warnIfBlack(image, args.scene);
+    writeImage(image, frames[i].second, args.exposure);
+    if (args.timings) {
+      if (i == 0 && !autoNote.empty()) std::cout << autoNote << "\n";
+      std::cout << formatTimings(report);
+    }
+    if (frames.size() > 1) {
+      // One plain line per frame, never a carriage return: readable in a log as on a terminal.
+      const double ms = std::chrono::duration<double, std::milli>(CliClock::now() - frameStart).count();
+      std::cerr << "render: frame " << (i + 1) << "/" << frames.size() << " (t = " << formatNumber(frames[i].first)
+                << ") " << frames[i].second << " " << long(ms + 0.5) << " ms" << std::endl;
+    }
+    printWrote(frames[i].second, imageSizeText(image), start);
+  }
   return 0;
 }
 
 struct ReferenceArgs {
   std::string scene, output;
+  double time = 0.0;
   int spp = 0;
   std::uint64_t seed = 0;
   int threads = 0;
@@ -206,7 +291,7 @@ int runReference(const ReferenceArgs& args) {
   requireWritableOutput(args.output);
   requireWritableOutput(errorFile);
 
-  const Scene scene = loadScene(args.scene);
+  const Scene scene = sceneAtTime(loadScene(args.scene), args.time);
   warnAboutScene(scene);
   const ReferenceTracer tracer(scene);
   ReferenceOptions options;
@@ -254,6 +339,10 @@ int main(int argc, char** argv) {
                          "Propagation coefficients: calibrated (default) or seed (overrides lpv.scheme)");
   renderCmd->add_option("--exposure", render.exposure, "PNG only: multiply radiance before tone mapping");
   renderCmd->add_flag("--timings", render.timings, "Print the per-stage timing table");
+  renderCmd->add_option("--time", render.time, "Pose a deforming scene (its \"deformers\") at this time");
+  renderCmd->add_option("--frames", render.frames,
+                        "Render frames A:B[:STEP] (time = frame / --fps) to -o's %04d-style pattern");
+  renderCmd->add_option("--fps", render.fps, "Frames per unit of scene time for --frames (default 24)");
 
   std::string inspectFile;
   CLI::App* inspectCmd = app.add_subcommand("inspect", "Report the grids of a VDB material set and validate it");
@@ -270,6 +359,7 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--spp", reference.spp, "Samples per pixel")->required();
   referenceCmd->add_option("--exposure", reference.exposure, "PNG only: multiply radiance before tone mapping");
   referenceCmd->add_option("--seed", reference.seed, "Random seed (same seed, same image)");
+  referenceCmd->add_option("--time", reference.time, "Pose a deforming scene (its \"deformers\") at this time");
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
   referenceCmd->add_option("--max-scatter", reference.maxScatter,
                            "End paths after this many scattering events (0: unlimited; 1: single scattering only)");

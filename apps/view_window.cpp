@@ -33,10 +33,9 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Animation: a scene with animated parts answers true and is built at time t here; every
-// scene is static until then, and the time keys (Space, Left, Right) do nothing.
-bool sceneIsAnimated(const Scene& /*scene*/) { return false; }
-Scene sceneAtTime(const Scene& scene, double /*time*/) { return scene; }
+// Animation: a scene with deformers plays (sslpv::sceneAtTime poses it); a static scene's
+// time keys (Space, Left, Right) do nothing.
+bool sceneIsAnimated(const Scene& scene) { return !scene.deformers.empty(); }
 
 constexpr auto kPollInterval = std::chrono::milliseconds(500);  // how often the files' mtimes are read
 constexpr auto kTitleInterval = std::chrono::milliseconds(250);

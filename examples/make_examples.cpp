@@ -25,6 +25,8 @@
 #include <utility>
 #include <vector>
 
+#include "volume/material_set.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -455,6 +457,59 @@ std::string ketchupBoxScene() {
          camera({40.0, 45.0, 75.0}, {0.0, 5.0, 0.0}, 35.0) + lpv(32, 256) + "}\n";
 }
 
+// The bending bar: a 40 x 8 x 8 mm bar along x whose far end carries a painted stripe,
+// bent up a quarter turn about its left end and back over t in [0, 1] (the scene's
+// "deformers"). The stripe lives in the bar's rest space, so it must ride up with the end.
+constexpr double kStripeVoxelMm = 0.5;
+
+std::size_t writeBarStripe(const fs::path& file) {
+  auto set = std::make_shared<sslpv::MaterialSet>();
+  set->sigmaT = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  set->sigmaS = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  set->sigmaT->setName("sigma_t");
+  set->sigmaS->setName("sigma_s");
+  for (auto& grid : {set->sigmaT, set->sigmaS}) {
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(kStripeVoxelMm));
+    grid->setVectorType(openvdb::VEC_INVARIANT);
+    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+  }
+  set->units = "mm";
+  set->creator = "sslpv make_examples";
+  auto t = set->sigmaT->getAccessor();
+  auto s = set->sigmaS->getAccessor();
+  std::size_t voxels = 0;
+  // x from 10 to 15 mm, one voxel beyond the bar's 8 x 8 mm cross section on each side so
+  // trilinear lookups just inside the surface read the stripe, not a blend to the base.
+  for (int i = 20; i <= 30; ++i)
+    for (int j = -9; j <= 9; ++j)
+      for (int k = -9; k <= 9; ++k) {
+        // A dark wine-red band: strongly absorbing in green and blue, still scattering.
+        t.setValue(openvdb::Coord(i, j, k), openvdb::Vec3s(3.0f, 9.0f, 10.0f));
+        s.setValue(openvdb::Coord(i, j, k), openvdb::Vec3s(2.4f, 1.2f, 1.0f));
+        ++voxels;
+      }
+  sslpv::saveMaterialSet(*set, file);
+  return voxels;
+}
+
+std::string bendingBarScene() {
+  return std::string("{\n") +
+         "  \"units\": \"mm\",\n"
+         "  \"mesh\": {\"primitive\": \"box\", \"min\": [-20, -4, -4], \"max\": [20, 4, 4], "
+         "\"segments\": [40, 4, 4]},\n"
+         "  \"material\": {\"base\": {\"preset\": \"skimmilk\"}, \"vdb\": \"bending_bar_stripe.vdb\", "
+         "\"ior\": 1.3},\n"
+         "  \"deformers\": [\n"
+         "    {\"type\": \"bend\", \"axis\": \"x\", \"toward\": \"y\", \"center\": [-20, 0, 0], \"length\": 40,\n"
+         "     \"angle\": [{\"t\": 0, \"value\": 0}, {\"t\": 0.5, \"value\": 90, \"ease\": \"smoothstep\"},\n"
+         "               {\"t\": 1, \"value\": 0, \"ease\": \"smoothstep\"}]}\n"
+         "  ],\n"
+         "  \"lights\": [\n" +
+         spotLight({-60.0, 70.0, 60.0}, {0.0, 5.0, 0.0}, 40.0, {16000.0, 15500.0, 15000.0}) + ",\n" +
+         pointLight({30.0, 10.0, -50.0}, {5000.0, 5000.0, 5000.0}) + "\n  ],\n" +
+         camera({0.0, 14.0, 100.0}, {-2.0, 10.0, 0.0}, 40.0) + lpv(32, 256) + "}\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -478,11 +533,14 @@ int main(int argc, char** argv) {
     writeText(dir / "jade_slab_backlit.json", jadeSlabScene());
     writeText(dir / "skin_sphere.json", skinSphereScene());
     writeText(dir / "ketchup_box.json", ketchupBoxScene());
+    const std::size_t stripeVoxels = writeBarStripe(dir / "bending_bar_stripe.vdb");
+    writeText(dir / "bending_bar.json", bendingBarScene());
 
     std::cout << "make_examples: wrote " << dir.string() << ": pebble.obj ("
               << pebble.positions.size() << " vertices, " << pebble.triangles.size()
               << " triangles), marble_veins.vdb (" << counts.veinVoxels << " vein voxels, "
-              << counts.patchVoxels << " warm-patch voxels), 4 scenes\n";
+              << counts.patchVoxels << " warm-patch voxels), bending_bar_stripe.vdb (" << stripeVoxels
+              << " stripe voxels), 5 scenes\n";
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "make_examples: error: " << e.what() << "\n";

@@ -63,6 +63,16 @@ void VulkanRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, cons
   dirty_.materialChanged(touched);
 }
 
+void VulkanRenderer::setTime(double t) {
+  if (!object_.deformed()) return;
+  object_.setTime(t);
+  scene_.time = t;
+  mesh_->updatePositions(device_, object_.mesh().positions);
+  // The shadow views are placed around the mesh's bounds.
+  lightsUploaded_ = false;
+  dirty_.geometryChanged();
+}
+
 void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& report) {
   const GridFrame frame = makeGridFrame(object_.bounds(), settings.resolution);
   requireLpvMemory(frame, vulkanLpvBytes(frame), "vulkan");

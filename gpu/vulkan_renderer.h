@@ -41,6 +41,10 @@ class VulkanRenderer {
   void setCamera(const Camera& camera);
   void setLights(const std::vector<Light>& lights);
   void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched);
+  /// Poses a deforming scene at time `t` (as CpuRenderer::setTime): new vertex positions
+  /// on the device, then voxelization onwards. Each frame propagates cold, as every
+  /// frame of this backend does.
+  void setTime(double t);
 
   const Scene& scene() const { return scene_; }
   /// Per pixel of the last shaded frame, the 1-based index of the triangle seen there

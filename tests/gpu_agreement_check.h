@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "gpu/vulkan_renderer.h"
 #include "image_agreement.h"
@@ -13,6 +14,7 @@
 #include "volume/mesh.h"
 #include "volume/ray_scene.h"
 #include "volume/scene.h"
+#include "volume/scene_object.h"
 
 namespace sslpv::test {
 
@@ -32,8 +34,11 @@ inline double meanLitRadiance(const Image& image) {
 /// images to agree: mean relative difference <= 1 %, every interior pixel within 8 %
 /// (relative to max(cpu, 1e-3 x the mean)), edge pixels <= 1 % and background mismatches
 /// <= 0.1 % of the object, the same occupied cells, no surface mismatch.
+/// With `moveTo` (a deforming scene), both renderers first render a frame at scene.time,
+/// then setTime(*moveTo), and that second frame is compared.
 inline void expectGpuAgreement(const Scene& scene, const gpu::VulkanDevice& device,
-                               std::shared_ptr<const MaterialSet> set = nullptr) {
+                               std::shared_ptr<const MaterialSet> set = nullptr,
+                               std::optional<double> moveTo = std::nullopt) {
   CpuRenderer cpu(scene);
   gpu::VulkanRenderer vulkan(scene, device);
   if (set) {
@@ -41,10 +46,19 @@ inline void expectGpuAgreement(const Scene& scene, const gpu::VulkanDevice& devi
     vulkan.setMaterialSet(set, std::nullopt);
   }
   RenderReport cpuReport, gpuReport;
+  if (moveTo) {
+    cpu.render(scene.lpv);
+    vulkan.render(scene.lpv);
+    cpu.setTime(*moveTo);
+    vulkan.setTime(*moveTo);
+  }
   const Image cpuImage = cpu.render(scene.lpv, &cpuReport);
   const Image gpuImage = vulkan.render(scene.lpv, &gpuReport);
   ASSERT_EQ(cpuImage.pixels.size(), gpuImage.pixels.size());
-  const RayScene rays(loadMesh(scene.mesh, scene.transform));
+  // The surface as posed (a deforming scene's mesh is not the file's).
+  Scene posed = moveTo ? sceneAtTime(scene, *moveTo) : scene;
+  posed.material.vdb.reset();
+  const RayScene rays(SceneObject(posed).mesh());
   const ImageAgreement a = compareImages(gpuImage, cpuImage, vulkan.readTriangles(), cpuTriangles(scene.camera, rays),
                                          1e-3 * meanLitRadiance(cpuImage));
   char line[400];

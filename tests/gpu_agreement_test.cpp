@@ -62,6 +62,18 @@ TEST_F(GpuAgreement, SeedSchemeToo) {
   }
 }
 
+// A deformed frame: the bending bar bent a quarter turn, posed through setTime after a
+// straight frame (new vertices, a new grid, the stripe resampled through the inverse), on
+// both backends, held to the same tolerances as the static scenes.
+TEST_F(GpuAgreement, ADeformedFrameAfterSetTime) {
+  const Scene scene = smaller(loadScene(test::examplesDir() / "bending_bar.json"));
+  ASSERT_FALSE(scene.deformers.empty());
+  SCOPED_TRACE("bending_bar.json at t = 0.5 after t = 0");
+  test::expectGpuAgreement(scene, device(), nullptr, 0.5);
+  SCOPED_TRACE("bending_bar.json at t = 0.3, posed at load");
+  expectAgreement(sceneAtTime(scene, 0.3));
+}
+
 /// A random closed primitive, homogeneous preset material, one or two random lights of
 /// each kind, a random camera looking at it.
 std::string randomScene(std::mt19937& rng) {

@@ -64,6 +64,18 @@ void CpuRenderer::setMaterialSet(std::shared_ptr<const MaterialSet> set, const s
   coarse_.materialChanged(touched);
 }
 
+void CpuRenderer::setTime(double t) {
+  if (!object_.deformed()) return;
+  object_.setTime(t);
+  scene_.time = t;
+  rays_ = std::make_unique<RayScene>(object_.mesh());
+  dirty_.geometryChanged();
+  surface_.reset();
+  // The light may start the next run (any start converges to the new solution), but the
+  // cells the stop rule watches follow the new surface.
+  warm_.shell.clear();
+}
+
 Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
   Stopwatch frameWatch;
   if (lastSettings_) {

@@ -41,6 +41,14 @@ class CpuRenderer {
   /// `touched` (world bounds; everything when absent) and re-propagates.
   void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched);
 
+  /// Poses a deforming scene (Scene::deformers) at time `t`: the next frame re-voxelizes,
+  /// re-resamples through the new inverse and re-runs everything after. The last frame's
+  /// light starts the propagation only where the grid frame is unchanged (the deformed
+  /// bounds decide the frame, so a bending object mostly gets a new one and a coarse
+  /// start instead). InputError, renderer unchanged, when the pose folds the mesh; no-op
+  /// without deformers.
+  void setTime(double t);
+
   /// The next propagation starts cold, as the first frame's does, instead of from the
   /// last frame's converged light (benchmarks of whole frames, comparisons).
   void resetPropagation() { warm_.clear(); }

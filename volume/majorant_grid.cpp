@@ -92,7 +92,9 @@ double worldVoxelSize(const GridT& grid, const glm::dmat4& restToWorld) {
 }  // namespace
 
 MajorantGrid::MajorantGrid(const Bounds& bounds, const MaterialSample& base, const MaterialSet* set,
-                           const glm::dmat4& restToWorld, double sigmaScale, const MajorantGridOptions& options) {
+                           const glm::dmat4& restToWorld, double sigmaScale, const MajorantGridOptions& givenOptions) {
+  MajorantGridOptions options = givenOptions;
+  options.global = options.global || options.deformed;
   const glm::dvec3 baseSigmaT(base.sigmaT);
   global_ = baseSigmaT;
   const glm::dvec3 extent = glm::max(bounds.extent(), glm::dvec3(0.0));
@@ -143,6 +145,7 @@ MajorantGrid::MajorantGrid(const Bounds& bounds, const MaterialSample& base, con
         first[a] = int(std::clamp(from, 0.0, dims_[a] - 1.0));
         last[a] = int(std::clamp(to, 0.0, dims_[a] - 1.0));
       }
+      if (options.deformed) inside = true;  // one brick: first = last = 0
       if (!inside) continue;
       const glm::dvec3 value = scale * valueOf(*it);
       for (int z = first.z; z <= last.z; ++z)

@@ -41,6 +41,11 @@ struct MajorantGridOptions {
   /// One brick with the global majorant and a zero minorant (plain ratio tracking): the
   /// tracer's behaviour before bricks, kept for comparisons and tests.
   bool global = false;
+  /// The set reaches world space through a non-linear map `restToWorld` does not describe
+  /// (a deformation, volume/deform.h): implies `global`, and the one brick is
+  /// heterogeneous wherever the set has an active voxel, not only where `restToWorld`
+  /// puts one inside the bounds.
+  bool deformed = false;
 };
 
 class MajorantGrid {

@@ -47,6 +47,7 @@ struct IndexMap {
   glm::dmat3 linear{1.0};
   glm::dvec3 translation{0.0};
   glm::dmat4 worldToRest{1.0};
+  const DeformationPose* deformation = nullptr;  ///< General only: deformed object -> rest
   const openvdb::math::Transform* transform = nullptr;
 
   glm::dvec3 toIndex(const glm::dvec3& world) const {
@@ -58,19 +59,23 @@ struct IndexMap {
       case Kind::General:
         break;
     }
-    glm::dvec4 rest = worldToRest * glm::dvec4(world, 1.0);
-    openvdb::Vec3d index = transform->worldToIndex(openvdb::Vec3d(rest.x, rest.y, rest.z) / rest.w);
+    const glm::dvec4 object = worldToRest * glm::dvec4(world, 1.0);
+    glm::dvec3 rest = glm::dvec3(object) / object.w;
+    if (deformation) rest = deformation->inverse(rest);
+    openvdb::Vec3d index = transform->worldToIndex(openvdb::Vec3d(rest.x, rest.y, rest.z));
     return {index[0], index[1], index[2]};
   }
 };
 
-IndexMap makeIndexMap(const openvdb::math::Transform& transform, const glm::dmat4& worldToRest) {
+IndexMap makeIndexMap(const openvdb::math::Transform& transform, const glm::dmat4& worldToRest,
+                      const DeformationPose* deformation) {
   IndexMap map;
   map.worldToRest = worldToRest;
   map.transform = &transform;
+  map.deformation = deformation;
   const bool restIsAffine =
       worldToRest[0][3] == 0.0 && worldToRest[1][3] == 0.0 && worldToRest[2][3] == 0.0 && worldToRest[3][3] == 1.0;
-  if (!transform.isLinear() || !restIsAffine) return map;
+  if (!transform.isLinear() || !restIsAffine || deformation) return map;
 
   // OpenVDB matrices act on row vectors: index = rest * M, translation in row 3.
   const openvdb::Mat4d restToIndex = transform.baseMap()->getAffineMap()->getMat4().inverse();
@@ -234,6 +239,7 @@ struct FieldChannel {
 
 struct MaterialField::Prepared {
   std::shared_ptr<const MaterialSet> set;  ///< keeps the trees alive
+  std::shared_ptr<const DeformationPose> deformation;  ///< keeps the channels' maps' pose alive
   FieldChannel<openvdb::Vec3STree> sigmaT, sigmaS;
   FieldChannel<openvdb::FloatTree> g;
 };
@@ -242,7 +248,7 @@ namespace {
 
 template <class GridT>
 FieldChannel<typename GridT::TreeType> prepareChannel(const typename GridT::Ptr& grid, const glm::dmat4& worldToRest,
-                                                      double scale,
+                                                      const DeformationPose* deformation, double scale,
                                                       const typename Channel<typename GridT::TreeType>::Sum& base) {
   FieldChannel<typename GridT::TreeType> channel;
   channel.scale = scale;
@@ -252,25 +258,32 @@ FieldChannel<typename GridT::TreeType> prepareChannel(const typename GridT::Ptr&
   if (!grid->tree().evalActiveVoxelBoundingBox(active)) return channel;  // nothing active: base
   channel.tree = &grid->tree();
   channel.active = active;
-  channel.map = makeIndexMap(grid->constTransform(), worldToRest);
+  channel.map = makeIndexMap(grid->constTransform(), worldToRest, deformation);
   return channel;
 }
 
 }  // namespace
 
 MaterialField::MaterialField(const MaterialSample& base, std::shared_ptr<const MaterialSet> set,
-                             const glm::dmat4& worldToRest, double sigmaScale)
-    : base_(base), set_(std::move(set)), worldToRest_(worldToRest), sigmaScale_(sigmaScale) {
+                             const glm::dmat4& worldToRest, double sigmaScale,
+                             std::shared_ptr<const DeformationPose> deformation)
+    : base_(base),
+      set_(std::move(set)),
+      worldToRest_(worldToRest),
+      sigmaScale_(sigmaScale),
+      deformation_(std::move(deformation)) {
   if (!std::isfinite(sigmaScale) || sigmaScale < 0.0)
     throw std::invalid_argument("MaterialField: sigmaScale must be finite and non-negative");
   if (!set_) return;
   auto prepared = std::make_shared<Prepared>();
   prepared->set = set_;
+  prepared->deformation = deformation_;
+  const DeformationPose* pose = deformation_.get();
   prepared->sigmaT =
-      prepareChannel<openvdb::Vec3SGrid>(set_->sigmaT, worldToRest_, sigmaScale_, glm::dvec3(base_.sigmaT));
+      prepareChannel<openvdb::Vec3SGrid>(set_->sigmaT, worldToRest_, pose, sigmaScale_, glm::dvec3(base_.sigmaT));
   prepared->sigmaS =
-      prepareChannel<openvdb::Vec3SGrid>(set_->sigmaS, worldToRest_, sigmaScale_, glm::dvec3(base_.sigmaS));
-  prepared->g = prepareChannel<openvdb::FloatGrid>(set_->g, worldToRest_, 1.0, double(base_.g));
+      prepareChannel<openvdb::Vec3SGrid>(set_->sigmaS, worldToRest_, pose, sigmaScale_, glm::dvec3(base_.sigmaS));
+  prepared->g = prepareChannel<openvdb::FloatGrid>(set_->g, worldToRest_, pose, 1.0, double(base_.g));
   prepared_ = std::move(prepared);
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "volume/deform.h"
 #include "volume/lpv_grid.h"
 #include "volume/material.h"
 #include "volume/mesh.h"
@@ -72,11 +73,15 @@ bool inspectVdbFile(const std::filesystem::path& file, std::ostream& report);
 /// outside a grid take the base material's value. `worldToRest` maps world points into
 /// the grids' (object rest) space. `sigmaScale` multiplies the σ read from the grids to
 /// convert the file's units to the scene's (σ is intrinsic: scaling the object does not
-/// change it). Thread-safe: each thread makes its own Sampler.
+/// change it). With `deformation`, `worldToRest` reaches the deformed object space and
+/// the deformation's inverse then the rest space the grids live in (volume/deform.h); box
+/// averages are then stratified point averages, the map being non-linear.
+/// Thread-safe: each thread makes its own Sampler.
 class MaterialField {
  public:
   MaterialField(const MaterialSample& base, std::shared_ptr<const MaterialSet> set,
-                const glm::dmat4& worldToRest, double sigmaScale);
+                const glm::dmat4& worldToRest, double sigmaScale,
+                std::shared_ptr<const DeformationPose> deformation = nullptr);
 
   /// Holds ValueAccessors and scratch buffers: cheap to create (one allocation, no tree
   /// traversal), one per thread. Copies share that state: do not use a Sampler and its
@@ -104,6 +109,7 @@ class MaterialField {
   std::shared_ptr<const MaterialSet> set_;
   glm::dmat4 worldToRest_;
   double sigmaScale_;
+  std::shared_ptr<const DeformationPose> deformation_;
   /// Per-grid maps from world to index space and active bounding boxes, computed once
   /// here so that making a Sampler costs no tree traversal.
   struct Prepared;

@@ -46,6 +46,53 @@ std::string coordinateRange() {
   return text;
 }
 
+/// A box whose faces are grids of segments[b] x segments[c] quads, welded along the edges.
+TriangleMesh makeSegmentedBox(const MeshSource& source) {
+  const glm::ivec3 n = source.boxSegments;
+  TriangleMesh mesh;
+  mesh.name = "box";
+  std::unordered_map<std::size_t, std::uint32_t> indexOf;
+  auto vertex = [&](const glm::ivec3& c) {
+    const std::size_t key = (std::size_t(c.z) * std::size_t(n.y + 1) + std::size_t(c.y)) * std::size_t(n.x + 1) +
+                            std::size_t(c.x);
+    const auto [it, added] = indexOf.emplace(key, std::uint32_t(mesh.positions.size()));
+    if (added) {
+      glm::dvec3 p;
+      for (int a = 0; a < 3; ++a)
+        p[a] = c[a] == n[a] ? source.boxMax[a]
+                            : source.boxMin[a] + (source.boxMax[a] - source.boxMin[a]) * double(c[a]) / double(n[a]);
+      mesh.positions.emplace_back(p);
+    }
+    return it->second;
+  };
+  for (int a = 0; a < 3; ++a) {
+    // (b, c) in cyclic order after a, so b x c points along +a.
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    for (int side = 0; side < 2; ++side)
+      for (int i = 0; i < n[b]; ++i)
+        for (int j = 0; j < n[c]; ++j) {
+          glm::ivec3 p00(0);
+          p00[a] = side ? n[a] : 0;
+          p00[b] = i;
+          p00[c] = j;
+          glm::ivec3 p10 = p00, p01 = p00;
+          p10[b] += 1;
+          p01[c] += 1;
+          glm::ivec3 p11 = p10;
+          p11[c] += 1;
+          const std::uint32_t v00 = vertex(p00), v10 = vertex(p10), v11 = vertex(p11), v01 = vertex(p01);
+          if (side) {
+            mesh.triangles.push_back({v00, v10, v11});
+            mesh.triangles.push_back({v00, v11, v01});
+          } else {
+            mesh.triangles.push_back({v00, v11, v10});
+            mesh.triangles.push_back({v00, v01, v11});
+          }
+        }
+  }
+  return mesh;
+}
+
 TriangleMesh makeBox(const MeshSource& source) {
   for (int axis = 0; axis < 3; ++axis) {
     if (!(source.boxMin[axis] < source.boxMax[axis]) || !std::isfinite(source.boxMin[axis]) ||
@@ -53,6 +100,7 @@ TriangleMesh makeBox(const MeshSource& source) {
       throw InputError("box: min " + formatPoint(source.boxMin) + " must be below max " +
                        formatPoint(source.boxMax) + " on every axis");
   }
+  if (source.boxSegments != glm::ivec3(1)) return makeSegmentedBox(source);
   TriangleMesh mesh;
   mesh.name = "box";
   // Corner i has x from bit 0, y from bit 1, z from bit 2.

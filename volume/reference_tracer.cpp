@@ -266,8 +266,12 @@ ReferenceTracer::ReferenceTracer(const Scene& scene, std::shared_ptr<const Mater
     impl_->object->setMaterialSet(set);
   }
   impl_->base = impl_->object->field().base();
+  // A deformed object's voxels reach world space through a non-linear map that the
+  // bricks' corner bounds do not bound: one global majorant stays conservative.
+  MajorantGridOptions brickOptions = majorants;
+  brickOptions.deformed = impl_->object->deformed();
   impl_->majorants = std::make_unique<MajorantGrid>(impl_->object->bounds(), impl_->base, set.get(),
-                                                    scene.transform.matrix(), sigmaScale, majorants);
+                                                    scene.transform.matrix(), sigmaScale, brickOptions);
   majorant_ = impl_->majorants->globalMajorant();
   impl_->rays = std::make_unique<RayScene>(impl_->object->mesh());
   impl_->eta = scene.material.ior;

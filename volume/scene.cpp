@@ -131,8 +131,17 @@ MeshSource parseMesh(const SceneReader& in, const json& node) {
   }
   std::string kind = in.string(*primitive, childPath(path, "primitive"));
   if (kind == "box") {
-    in.allowOnly(node, path, {"primitive", "min", "max"});
+    in.allowOnly(node, path, {"primitive", "min", "max", "segments"});
     mesh.kind = MeshSource::Kind::Box;
+    if (const json* v = in.optional(node, "segments")) {
+      const std::string segmentsPath = childPath(path, "segments");
+      if (!v->is_array() || v->size() != 3)
+        in.fail(segmentsPath, "expected an array of 3 whole numbers in [1, " + std::to_string(kMaxBoxSegments) +
+                                  "], got " + describeType(*v));
+      for (int i = 0; i < 3; ++i)
+        mesh.boxSegments[i] = in.integer((*v)[std::size_t(i)], indexPath(segmentsPath, std::size_t(i)), 1,
+                                         kMaxBoxSegments);
+    }
     mesh.boxMin = in.coordinate(in.required(node, path, "min"), childPath(path, "min"));
     mesh.boxMax = in.coordinate(in.required(node, path, "max"), childPath(path, "max"));
     static const char* const kAxis[] = {"x", "y", "z"};
@@ -343,7 +352,7 @@ Scene parseScene(const std::string& jsonText, const fs::path& file) {
 
   SceneReader in(file);
   if (!root.is_object()) in.fail("", "expected a JSON object at the top level, got " + describeType(root));
-  in.allowOnly(root, "", {"units", "mesh", "transform", "material", "lights", "camera", "lpv"});
+  in.allowOnly(root, "", {"units", "mesh", "transform", "material", "lights", "camera", "lpv", "deformers"});
 
   Scene scene;
   scene.file = file;
@@ -371,7 +380,17 @@ Scene parseScene(const std::string& jsonText, const fs::path& file) {
     // whatever a fixed step count happens to reach (8 steps leave a large object dark).
     scene.lpv.autoSteps = true;
   }
+  if (const json* v = in.optional(root, "deformers")) scene.deformers = parseDeformers(in, *v);
   return scene;
+}
+
+Scene sceneAtTime(const Scene& scene, double t) {
+  if (!(std::abs(t) <= kMaxTime))
+    throw InputError("--time: must be a number in [" + formatNumber(-kMaxTime) + ", " + formatNumber(kMaxTime) +
+                     "], got " + formatNumber(t));
+  Scene posed = scene;
+  posed.time = t;
+  return posed;
 }
 
 Scene loadScene(const fs::path& file) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "volume/deform.h"
 #include "volume/lpv_calibration.h"
 #include "volume/material.h"
 
@@ -25,6 +26,9 @@ struct MeshSource {
   std::filesystem::path path;  ///< Kind::File: resolved against the scene file's folder
   std::shared_ptr<const TriangleMesh> mesh;  ///< Kind::InMemory: in the object's rest space
   glm::dvec3 boxMin{-0.5}, boxMax{0.5};
+  /// Box: quads along x, y, z per face (1, 1, 1: the 12-triangle box). A deformer bends
+  /// only what has vertices to move, so a bar that bends needs segments along its length.
+  glm::ivec3 boxSegments{1};
   glm::dvec3 center{0.0};
   double radius = 0.5;
 };
@@ -81,13 +85,24 @@ struct Scene {
   std::vector<Light> lights;
   Camera camera;
   LpvSettings lpv;
+  /// Applied in order to the mesh in rest space, before `transform` (volume/deform.h).
+  std::vector<Deformer> deformers;
+  /// The time the deformers are evaluated at (`--time`); unused without deformers.
+  double time = 0.0;
 };
+
+/// `scene` posed at time `t`: every backend that loads it deforms the mesh at `t` and
+/// samples the rest-space material set through the inverse deformation. InputError
+/// naming the flag when `t` is not finite or beyond ±kMaxTime.
+Scene sceneAtTime(const Scene& scene, double t);
 
 /// Largest accepted lpv.resolution / --grid: beyond it the grids do not fit in memory.
 inline constexpr int kMaxLpvResolution = 512;
 inline constexpr int kMaxShadowMap = 8192;
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr int kMaxSteps = 1000000;
+/// mesh.segments per axis of a box primitive.
+inline constexpr int kMaxBoxSegments = 256;
 
 /// Command-line overrides of a scene's lpv settings (`render`, `edit`); empty = keep.
 struct LpvFlags {

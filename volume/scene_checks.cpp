@@ -81,7 +81,18 @@ std::vector<std::string> sceneWarnings(const Scene& scene, const TriangleMesh& w
 std::vector<std::string> sceneWarnings(const Scene& scene) {
   TriangleMesh mesh;
   try {
-    mesh = loadMesh(scene.mesh, scene.transform, /*warnReoriented=*/false);
+    if (scene.deformers.empty()) {
+      mesh = loadMesh(scene.mesh, scene.transform, /*warnReoriented=*/false);
+    } else {
+      // The warnings are about the object as posed (a camera inside the bent bar).
+      MeshSource posed;
+      posed.kind = MeshSource::Kind::InMemory;
+      auto deformed = std::make_shared<TriangleMesh>(loadMesh(scene.mesh, Transform{}, false));
+      deformed->positions =
+          deformPositions(deformed->positions, DeformationPose(scene.deformers, scene.time), "", scene.time);
+      posed.mesh = std::move(deformed);
+      mesh = loadMesh(posed, scene.transform, false);
+    }
   } catch (const InputError&) {
     return {};
   }

@@ -10,11 +10,20 @@ SceneObject::SceneObject(const Scene& scene)
     : base_(scene.material.base),
       vdbName_(scene.material.vdb ? scene.material.vdb->string() : std::string("material set")),
       unitInMm_(scene.unitInMm),
-      worldToRest_(glm::inverse(scene.transform.matrix())) {
+      worldToRest_(glm::inverse(scene.transform.matrix())),
+      sceneFile_(scene.file),
+      transform_(scene.transform),
+      deformers_(scene.deformers) {
   const auto start = std::chrono::steady_clock::now();
   try {
-    mesh_ = loadMesh(scene.mesh, scene.transform);
-    requireClosedMesh(mesh_);
+    if (deformers_.empty()) {
+      mesh_ = loadMesh(scene.mesh, scene.transform);
+      requireClosedMesh(mesh_);
+    } else {
+      // Kept in rest space: every pose starts from it, and the material set lives there.
+      restMesh_ = loadMesh(scene.mesh, Transform{});
+      requireClosedMesh(restMesh_);
+    }
   } catch (const InputError& e) {
     // The mesh's own message names a primitive ("box") or the mesh file; which scene and
     // key it came from is known only here.
@@ -22,9 +31,27 @@ SceneObject::SceneObject(const Scene& scene)
     const char* key = scene.mesh.kind == MeshSource::Kind::File ? "mesh.path" : "mesh";
     throw InputError(scene.file.string() + ": " + key + ": " + e.what());
   }
+  if (!deformers_.empty()) setTime(scene.time);
   bounds_ = mesh_.bounds();
   setMaterialSet(scene.material.vdb ? loadMaterialSet(*scene.material.vdb) : nullptr);
   loadMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void SceneObject::setTime(double t) {
+  if (deformers_.empty()) return;
+  auto pose = std::make_shared<const DeformationPose>(deformers_, t);
+  MeshSource posed;
+  posed.kind = MeshSource::Kind::InMemory;
+  auto deformed = std::make_shared<TriangleMesh>(restMesh_);
+  deformed->positions = deformPositions(restMesh_.positions, *pose, sceneFile_.string(), t);
+  posed.mesh = std::move(deformed);
+  // The transform's range check and orientation, as for a static mesh. Every deformer
+  // keeps orientation (a positive Jacobian on its domain), so nothing is turned here.
+  TriangleMesh mesh = loadMesh(posed, transform_, false);
+  mesh_ = std::move(mesh);
+  bounds_ = mesh_.bounds();
+  pose_ = std::move(pose);
+  if (field_) setMaterialSet(set_);
 }
 
 void SceneObject::setMaterialSet(std::shared_ptr<const MaterialSet> set) {
@@ -37,7 +64,7 @@ void SceneObject::setMaterialSet(std::shared_ptr<const MaterialSet> set) {
     sigmaScale = unitInMm_ / *fileUnit;
   }
   set_ = std::move(set);
-  field_ = std::make_unique<MaterialField>(base_, set_, worldToRest_, sigmaScale);
+  field_ = std::make_unique<MaterialField>(base_, set_, worldToRest_, sigmaScale, pose_);
 }
 
 }  // namespace sslpv

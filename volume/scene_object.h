@@ -14,8 +14,17 @@ namespace sslpv {
 class SceneObject {
  public:
   /// Loads the mesh (in world space, closed-ness checked) and the material set. Throws
-  /// InputError on bad input.
+  /// InputError on bad input. With deformers, the mesh is posed at scene.time and the
+  /// field maps points back to rest space through the pose's inverse.
   explicit SceneObject(const Scene& scene);
+
+  /// Poses the mesh at time `t` from the rest mesh kept at load (no file is read again)
+  /// and points the field at the new pose. InputError naming the deformer when the pose
+  /// folds the mesh; the object is then unchanged. Without deformers, nothing changes.
+  void setTime(double t);
+  bool deformed() const { return !deformers_.empty(); }
+  /// The pose of the last setTime (null without deformers).
+  const std::shared_ptr<const DeformationPose>& pose() const { return pose_; }
 
   /// A painted material set in the scene's material.vdb units (nullptr: base only).
   void setMaterialSet(std::shared_ptr<const MaterialSet> set);
@@ -32,6 +41,11 @@ class SceneObject {
   std::string vdbName_;
   double unitInMm_;
   glm::dmat4 worldToRest_;
+  std::filesystem::path sceneFile_;
+  Transform transform_;
+  std::vector<Deformer> deformers_;
+  TriangleMesh restMesh_;  ///< deformed scenes only: the mesh before deformers and transform
+  std::shared_ptr<const DeformationPose> pose_;
   TriangleMesh mesh_;
   Bounds bounds_;
   std::shared_ptr<const MaterialSet> set_;
