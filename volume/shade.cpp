@@ -160,6 +160,21 @@ class PixelShader {
   double radianceScale_ = 0.0, boundaryScale_ = 0.0;
 };
 
+/// Traces every image row in parallel and hands each row's pixels to `use(y, row)`; the
+/// row buffer is reused, so `use` copies what it keeps.
+template <typename UseRow>
+void forEachTracedRow(const Camera& camera, const RowTracer& tracer, UseRow&& use) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+    RowTracer::Buffers buffers;
+    std::vector<Pixel> row;
+    row.reserve(std::size_t(camera.width));
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      tracer.trace(y, buffers, row);
+      use(y, row);
+    }
+  });
+}
+
 }  // namespace
 
 ShadingSurface traceShadingSurface(const Camera& camera, const RayScene& rays, const MaterialGrid& material, double ior) {
@@ -167,17 +182,9 @@ ShadingSurface traceShadingSurface(const Camera& camera, const RayScene& rays, c
   surface.width = camera.width;
   surface.height = camera.height;
   surface.rows.resize(std::size_t(camera.height));
-  const RowTracer tracer(camera, rays, material, ior);
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-    RowTracer::Buffers buffers;
-    // A row's pixels gather here first, so that each kept row is allocated once, exactly.
-    std::vector<Pixel> row;
-    row.reserve(std::size_t(camera.width));
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      tracer.trace(y, buffers, row);
-      surface.rows[std::size_t(y)].assign(row.begin(), row.end());
-    }
-  });
+  // A row's pixels gather in a reused buffer first, so each kept row is allocated once, exactly.
+  forEachTracedRow(camera, RowTracer(camera, rays, material, ior),
+                   [&](int y, const std::vector<Pixel>& row) { surface.rows[std::size_t(y)].assign(row.begin(), row.end()); });
   return surface;
 }
 
@@ -199,17 +206,9 @@ Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid&
   // Row by row, keeping nothing: a frame whose view is not reused should not pay for
   // storing it (tens of MB of fresh pages at 512²).
   Image image(camera.width, camera.height);
-  const RowTracer tracer(camera, rays, material, ior);
   const PixelShader shader(material, accumulated, ior, exitGain, reducedAlbedo, singleScattering);
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-    RowTracer::Buffers buffers;
-    std::vector<Pixel> row;
-    row.reserve(std::size_t(camera.width));
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      tracer.trace(y, buffers, row);
-      shader.shade(row, image);
-    }
-  });
+  forEachTracedRow(camera, RowTracer(camera, rays, material, ior),
+                   [&](int, const std::vector<Pixel>& row) { shader.shade(row, image); });
   return image;
 }
 
