@@ -130,7 +130,8 @@ void storeCell(int x, int y, int z, Gathered gathered, inout StepSums sums) {
     return;
   }
   for (int ch = 0; ch < 3; ++ch) {
-    gathered.c[ch] *= conductance[ch];
+    // A negative retention drains at most what the cell gathered (gatherSlice on the CPU).
+    gathered.c[ch] *= conductance[ch] * (gathered.c[ch].x > 0.0 ? 1.0 : 0.0);
     value[ch] = on * gathered.c[ch] * vec4(dc[ch], linear[ch], linear[ch], linear[ch]);
     destination[3 * i + ch] = value[ch];
     sums.gathered[ch] += on * gathered.c[ch].x;

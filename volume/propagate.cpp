@@ -178,6 +178,15 @@ void gatherSlice(int z, const StepFactors& factors, const ShGrid& src, ShGrid& d
           g.c0 *= conduct[i];
           for (float& c : g.c) c *= conduct[i];
         }
+        // A negative retention drains at most what the cell gathered: a cell driven below
+        // zero would emit nothing next step anyway, but its negative light would enter the
+        // accumulated sum and the power balance (the lattice would hand back more power
+        // than was injected once the clamp zeroes it).
+        if constexpr (kRetain) {
+          const float holds = g.c0 > 0.0f ? 1.0f : 0.0f;
+          g.c0 *= holds;
+          for (float& c : g.c) c *= holds;
+        }
         const float v0 = on * g.c0 * dc[i];
         const float v1 = on * g.c[0] * lin[i], v2 = on * g.c[1] * lin[i], v3 = on * g.c[2] * lin[i];
         out[0][i] = v0;
@@ -265,7 +274,8 @@ void gatherSliceIsotropic(int z, const StepFactors& factors, const ShGrid& src, 
 #pragma omp simd reduction(+ : emitted, gathered, absorbed, kept)
       for (int x = 0; x < row; ++x) {
         const std::size_t i = rowStart + x;
-        const float g = isotropicGather<kRetain, kConduct, true>(c0, retain, conduct, i, sy, sz);
+        // Drained to zero at most, as in gatherSlice.
+        const float g = std::max(0.0f, isotropicGather<kRetain, kConduct, true>(c0, retain, conduct, i, sy, sz));
         const float on = active[i] ? 1.0f : 0.0f;
         const float v0 = on * g * dc[i];
         out[i] = v0;
