@@ -74,7 +74,7 @@ void VulkanRenderer::setTime(double t) {
 }
 
 void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& report) {
-  const GridFrame frame = makeGridFrame(object_.bounds(), settings.resolution);
+  const GridFrame frame = makeGridFrame(object_.gridBounds(), settings.resolution);
   requireLpvMemory(frame, vulkanLpvBytes(frame), "vulkan");
   const bool sameFrame = voxelizer_ && voxelizer_->frame().dims == frame.dims &&
                          voxelizer_->frame().origin == frame.origin && voxelizer_->frame().cellSize == frame.cellSize;

@@ -272,9 +272,13 @@ TEST(Deformers, SetTimeRendersWhatAFreshRendererRenders) {
   fresh.setMaterialSet(stripeSet(), std::nullopt);
   RenderReport freshReport;
   const Image expected = fresh.render(scene.lpv, &freshReport);
-  // The bent bar's bounds differ from the straight one's: a new grid frame, so the frame
-  // starts cold (coarse start) exactly as the fresh renderer does.
-  EXPECT_FALSE(report.propagation.warmStarted);
+  // The grid is fitted to the animation's span, not to each pose, so both renderers use
+  // the same frame, and the moving one starts from the straight bar's light (warm start):
+  // it converges to the same light within the stop rule's 1e-2 per shaded cell.
+  EXPECT_EQ(report.frame.dims, freshReport.frame.dims);
+  EXPECT_EQ(report.frame.origin, freshReport.frame.origin);
+  EXPECT_EQ(report.frame.cellSize, freshReport.frame.cellSize);
+  EXPECT_TRUE(report.propagation.warmStarted);
   ASSERT_EQ(animated.pixels.size(), expected.pixels.size());
   double worst = 0.0, peak = 0.0;
   for (std::size_t i = 0; i < expected.pixels.size(); ++i) {
@@ -282,7 +286,7 @@ TEST(Deformers, SetTimeRendersWhatAFreshRendererRenders) {
     peak = std::max(peak, double(glm::length(expected.pixels[i])));
   }
   EXPECT_GT(peak, 0.0);
-  EXPECT_EQ(worst, 0.0);
+  EXPECT_LE(worst, 1e-2 * peak);
 }
 
 }  // namespace

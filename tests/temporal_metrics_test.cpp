@@ -35,9 +35,10 @@ TEST(TemporalChange, ALinearChangeHasNoFlickerAndAJumpIsAllFlicker) {
   // Alternating by ±0.01 about 1: every first difference 0.02, every second 0.04.
   const TemporalChange jitter = temporalChange(sequence(5, [](int t, int) { return t % 2 ? 1.01f : 0.99f; }));
   EXPECT_NEAR(jitter.flicker, 2.0 * jitter.motion, 1e-6);
-  // A pixel dark in any frame is left out.
+  // A pixel dark in any frame is left out, and so are its neighbours (a silhouette): pixel
+  // 3 is the corner (3, 0) of the 4x4 image, next to (2, 0) and (3, 1).
   const TemporalChange holes = temporalChange(sequence(3, [](int t, int i) { return i == 3 && t == 1 ? 0.0f : 1.0f; }));
-  EXPECT_EQ(holes.pixels, 15u);
+  EXPECT_EQ(holes.pixels, 13u);
   EXPECT_THROW(temporalChange(sequence(2, [](int, int) { return 1.0f; })), std::invalid_argument);
 }
 
@@ -71,3 +72,29 @@ TEST(TemporalChange, AnOrbitingLightDoesNotMakeThePreviewFlicker) {
 }
 
 }  // namespace
+
+TEST(TemporalChange, ABendingBarDoesNotJumpBetweenFrames) {
+  // The shipped bending bar advanced by 0.001 a frame (about 0.26° of bend, under a pixel of
+  // motion at the tip), each frame re-voxelized, resampled through the bend's inverse and
+  // warm-started. A grid refitted to every pose moved each cell by a fraction of a cell
+  // per frame and the image jumped by the lattice's cell-phase error: flicker 2.8 % of
+  // the mean luminance at 32³ and 256² (bench/flicker --animate 0.2 --step-time 0.001,
+  // 2026-12-04); with the grid fitted once to the animation's span, 0.47 %. Threshold:
+  // the 0.5 % of the orbiting light's check (one 8-bit mid-tone level), with the measured
+  // value at this test's size and frames below it.
+  Scene scene = loadScene(test::examplesDir() / "bending_bar.json");
+  scene.camera.width = scene.camera.height = 128;
+  scene.lpv.autoSteps = true;
+  CpuRenderer renderer(scene);
+  std::vector<Image> frames;
+  for (int f = 0; f < 8; ++f) {
+    renderer.setTime(0.2 + 0.001 * f);
+    frames.push_back(renderer.render(scene.lpv));
+  }
+  const TemporalChange change = temporalChange(frames);
+  std::printf("bending bar, 128², 32³: motion %.3e, flicker %.3e per frame (of the mean luminance)\n", change.motion,
+              change.flicker);
+  EXPECT_GT(change.pixels, 500u);
+  EXPECT_GT(change.motion, 1e-3) << "the bar must visibly move for the check to mean anything";
+  EXPECT_LT(change.flicker, 5e-3);
+}

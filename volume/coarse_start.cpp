@@ -55,7 +55,7 @@ bool CoarseStart::start(const SceneObject& object, const MaterialGrid& fine, con
   Level& level = *level_;
   if (!level.voxelized) {
     level.material = MaterialGrid{};
-    level.material.frame = makeGridFrame(object.bounds(), coarseResolution);
+    level.material.frame = makeGridFrame(object.gridBounds(), coarseResolution);
     level.material.meanChord = fine.meanChord;
     level.material.coverage = voxelizeCoverageParity(object.mesh(), level.material.frame);
     level.voxelized = true;

@@ -96,7 +96,7 @@ Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) 
 
   if (dirty_.dirty(Stage::Voxelize)) {
     material_ = MaterialGrid{};
-    material_.frame = makeGridFrame(object_.bounds(), settings.resolution);
+    material_.frame = makeGridFrame(object_.gridBounds(), settings.resolution);
     requireLpvMemory(material_.frame, estimateLpvBytes(material_.frame), "cpu");
     material_.meanChord = meanChordLength(object_.mesh());
     // The twin of the GPU voxelizer, so both backends see the same occupancy.

@@ -103,6 +103,9 @@ class MaterialField {
   Sampler sampler() const;
   const MaterialSample& base() const { return base_; }
   bool homogeneous() const { return !set_; }
+  /// Painted and posed by deformers: every sample goes back to rest space through their
+  /// inverse.
+  bool deformed() const { return set_ && deformation_; }
 
  private:
   MaterialSample base_;

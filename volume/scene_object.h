@@ -31,11 +31,19 @@ class SceneObject {
 
   const TriangleMesh& mesh() const { return mesh_; }
   const Bounds& bounds() const { return bounds_; }
+  /// The bounds the LPV grid is fitted to: bounds() for a static object; for a deformed
+  /// one, the union of its poses over the deformers' keyframed time span (sampled), so
+  /// that the grid's cells stay where they are as the object moves. A grid refitted to
+  /// each pose shifts every cell by a fraction of a cell per frame, and the image jumps
+  /// by the lattice's cell-phase error each time (bench/flicker --animate).
+  const Bounds& gridBounds() const { return deformers_.empty() ? bounds_ : animationBounds_; }
   const MaterialField& field() const { return *field_; }
   /// Milliseconds the constructor took (reported as the "load" stage).
   double loadMs() const { return loadMs_; }
 
  private:
+  Bounds boundsOverAnimation() const;
+
   // What the material field needs from the scene (copied: the object outlives no scene).
   MaterialSample base_;
   std::string vdbName_;
@@ -48,6 +56,7 @@ class SceneObject {
   std::shared_ptr<const DeformationPose> pose_;
   TriangleMesh mesh_;
   Bounds bounds_;
+  Bounds animationBounds_;  ///< deformed objects only: see gridBounds()
   std::shared_ptr<const MaterialSet> set_;
   std::unique_ptr<MaterialField> field_;
   double loadMs_ = 0.0;

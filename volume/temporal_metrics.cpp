@@ -16,10 +16,17 @@ TemporalChange temporalChange(const std::vector<Image>& frames) {
   TemporalChange change;
   double motion = 0.0, flicker = 0.0, total = 0.0;
   std::size_t firstDifferences = 0, secondDifferences = 0;
+  std::vector<unsigned char> lit(first.pixels.size(), 1);
+  for (std::size_t i = 0; i < first.pixels.size(); ++i)
+    for (const Image& f : frames) lit[i] = lit[i] && luminance(f.pixels[i]) > 0.0;
+  const int w = first.width, h = first.height;
   for (std::size_t i = 0; i < first.pixels.size(); ++i) {
-    bool litThroughout = true;
-    for (const Image& f : frames) litThroughout = litThroughout && luminance(f.pixels[i]) > 0.0;
-    if (!litThroughout) continue;
+    // Next to a pixel dark in some frame lies a silhouette, whose pixels change by their
+    // coverage as the object moves: motion of the outline, not of the shading.
+    const int x = int(i % std::size_t(w)), y = int(i / std::size_t(w));
+    const bool interior = lit[i] && (x == 0 || lit[i - 1]) && (x == w - 1 || lit[i + 1]) &&
+                          (y == 0 || lit[i - std::size_t(w)]) && (y == h - 1 || lit[i + std::size_t(w)]);
+    if (!interior) continue;
     ++change.pixels;
     for (std::size_t t = 0; t < frames.size(); ++t) {
       const double now = luminance(frames[t].pixels[i]);

@@ -11,15 +11,16 @@
 namespace sslpv {
 
 struct TemporalChange {
-  /// Mean over pixels lit in every frame and over consecutive frames of |L(t+1) − L(t)|
-  /// (luminance), divided by the mean luminance: the change per frame.
+  /// Mean over pixels lit in every frame, as are their four neighbours (no silhouette pixel,
+  /// whose change is the outline's coverage), and over consecutive frames of
+  /// |L(t+1) − L(t)| (luminance), divided by the mean luminance: the change per frame.
   double motion = 0.0;
   /// The same for the second difference |L(t+1) − 2 L(t) + L(t−1)|. A change that is
   /// smooth in time has flicker ≈ motion × (step / the time over which it bends), which
   /// halves with the step; a jump from one frame to the next counts in both, so flicker
   /// stays near motion whatever the step.
   double flicker = 0.0;
-  std::size_t pixels = 0;  ///< pixels lit in every frame
+  std::size_t pixels = 0;  ///< pixels counted: lit in every frame, and so are their neighbours
 };
 
 /// Throws std::invalid_argument for fewer than 3 frames or frames of different sizes.
