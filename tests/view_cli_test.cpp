@@ -188,6 +188,37 @@ TEST(ViewCli, ScriptedDragsOrbitTheCameraAndMoveTheLight) {
   EXPECT_GT(difference(orbited, lit).mean, 1.0);
 }
 
+// An animated scene: scrubbing forward poses the deformed object at the new time, and the
+// viewer shows what `sslpv render --time` draws for it (fixed steps: no warm start, so
+// both start from the same light); play then moves it on by itself.
+TEST(ViewCli, ScrubbedAnimationMatchesRenderAtThatTimeAndPlayMovesIt) {
+  if (const std::string why = xvfbSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  TempDir dir;
+  const fs::path scene = test::examplesDir() / "bending_bar.json";
+  // Four scrub steps of 0.05: t = 0.2.
+  test::writeText(dir / "script.txt",
+                  "1 screenshot " + (dir / "start.png").string() + "\n"
+                  "1 key right\n1 key right\n1 key right\n1 key right\n"
+                  "2 screenshot " + (dir / "scrubbed.png").string() + "\n"
+                  "2 key space\n");
+  const RunResult viewed =
+      runView(with({scene.string(), "--backend", "cpu", "--frames", "12", "--no-overlay", "--script",
+                    (dir / "script.txt").string(), "--screenshot", (dir / "played.png").string()},
+                   kFast));
+  SKIP_IF_NO_WINDOW(viewed);
+  ASSERT_EQ(viewed.exitCode, 0) << viewed.stderrText;
+  const RunResult rendered = test::runSslpv(with({"render", scene.string(), "--backend", "cpu", "--time", "0.2", "-o",
+                                                  (dir / "ref.png").string()},
+                                                 kFast));
+  ASSERT_EQ(rendered.exitCode, 0) << rendered.stderrText;
+  const std::vector<unsigned char> start = pngBytes(dir / "start.png");
+  const std::vector<unsigned char> scrubbed = pngBytes(dir / "scrubbed.png");
+  const ByteDifference d = difference(scrubbed, pngBytes(dir / "ref.png"));
+  EXPECT_LE(d.max, 1) << "mean " << d.mean;
+  EXPECT_GT(difference(start, scrubbed).mean, 1.0) << "scrubbing did not bend the bar";
+  EXPECT_GT(difference(scrubbed, pngBytes(dir / "played.png")).mean, 0.1) << "play did not move the animation on";
+}
+
 /// Runs the viewer on a background thread while the test changes its files on disk.
 class ViewerRun {
  public:
