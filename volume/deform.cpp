@@ -123,6 +123,22 @@ Deformer parseDeformer(const StrictJsonReader& in, const json& node, const std::
 
 double ease(double f, Ease e) { return e == Ease::Smoothstep ? f * f * (3.0 - 2.0 * f) : f; }
 
+/// Turns q about the deformer's axis by phi radians (a twist's slice at q).
+void turnAboutAxis(glm::dvec3& q, int axis, double phi) {
+  const int a = across(axis, 0), b = across(axis, 1);
+  const double c = std::cos(phi), sn = std::sin(phi);
+  const double x = q[a], y = q[b];
+  q[a] = c * x - sn * y;
+  q[b] = sn * x + c * y;
+}
+
+/// Scales q by `along` along the axis and by `acrossScale` across it.
+void scaleAlongAndAcross(glm::dvec3& q, int axis, double along, double acrossScale) {
+  q[axis] *= along;
+  q[across(axis, 0)] *= acrossScale;
+  q[across(axis, 1)] *= acrossScale;
+}
+
 }  // namespace
 
 const char* deformerTypeName(Deformer::Type type) {
@@ -164,27 +180,15 @@ glm::dvec3 PosedDeformer::forward(const glm::dvec3& rest) const {
       q[toward] = s * (2.0 * half * half / kk + v * std::cos(theta));
       break;
     }
-    case Deformer::Type::Twist: {
-      const int a = across(axis, 0), b = across(axis, 1);
-      const double phi = k * q[axis], c = std::cos(phi), sn = std::sin(phi);
-      const double x = q[a], y = q[b];
-      q[a] = c * x - sn * y;
-      q[b] = sn * x + c * y;
+    case Deformer::Type::Twist:
+      turnAboutAxis(q, axis, k * q[axis]);
       break;
-    }
-    case Deformer::Type::Taper: {
-      const double scale = 1.0 + k * q[axis];
-      q[across(axis, 0)] *= scale;
-      q[across(axis, 1)] *= scale;
+    case Deformer::Type::Taper:
+      scaleAlongAndAcross(q, axis, 1.0, 1.0 + k * q[axis]);
       break;
-    }
-    case Deformer::Type::SquashStretch: {
-      const double cross = 1.0 / std::sqrt(k);
-      q[axis] *= k;
-      q[across(axis, 0)] *= cross;
-      q[across(axis, 1)] *= cross;
+    case Deformer::Type::SquashStretch:
+      scaleAlongAndAcross(q, axis, k, 1.0 / std::sqrt(k));
       break;
-    }
   }
   return center + q;
 }
@@ -206,28 +210,18 @@ glm::dvec3 PosedDeformer::inverse(const glm::dvec3& deformed) const {
       q[toward] = s * (y * (2.0 - kk * y) - kk * x * x) / (1.0 + distance);
       break;
     }
-    case Deformer::Type::Twist: {
-      const int a = across(axis, 0), b = across(axis, 1);
-      const double phi = -k * q[axis], c = std::cos(phi), sn = std::sin(phi);
-      const double x = q[a], y = q[b];
-      q[a] = c * x - sn * y;
-      q[b] = sn * x + c * y;
+    case Deformer::Type::Twist:
+      turnAboutAxis(q, axis, -k * q[axis]);  // a twist keeps the coordinate along its axis
       break;
-    }
     case Deformer::Type::Taper: {
       const double scale = 1.0 + k * q[axis];
       if (!(scale > 0.0)) return glm::dvec3(std::nan(""));
-      q[across(axis, 0)] /= scale;
-      q[across(axis, 1)] /= scale;
+      scaleAlongAndAcross(q, axis, 1.0, 1.0 / scale);
       break;
     }
-    case Deformer::Type::SquashStretch: {
-      const double cross = std::sqrt(k);
-      q[axis] /= k;
-      q[across(axis, 0)] *= cross;
-      q[across(axis, 1)] *= cross;
+    case Deformer::Type::SquashStretch:
+      scaleAlongAndAcross(q, axis, 1.0 / k, std::sqrt(k));
       break;
-    }
   }
   return center + q;
 }
