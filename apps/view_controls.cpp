@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include "volume/math_constants.h"
 
 namespace sslpv {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMaxElevation = 85.0 * kPi / 180.0;
 constexpr double kRadiansPerPixel = 0.01;  // a 300-pixel drag turns about 170 degrees
 constexpr double kZoomPerWheelStep = 0.9;

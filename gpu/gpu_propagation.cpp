@@ -23,16 +23,6 @@ constexpr VkDeviceSize kEnergyRowBytes = SSLPV_ENERGY_FLOATS * sizeof(float);
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 constexpr VkBufferUsageFlags kField = kStorage | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-glm::dvec3 gridPower(const ShGrid& grid) {
-  glm::dvec3 power(0.0);
-  for (int ch = 0; ch < 3; ++ch) {
-    double sum = 0.0;
-    for (float c0 : grid.planes[ch * 4]) sum += c0;
-    power[ch] = sum * sh::kFluxPerC0;
-  }
-  return power;
-}
-
 void requireFrame(const ShGrid& grid, const GridFrame& frame, const char* what) {
   if (grid.frame.dims != frame.dims)
     throw GpuError(std::string("GpuPropagator: ") + what + " grid is not on the propagator's frame");

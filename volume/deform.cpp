@@ -9,13 +9,13 @@
 #include "volume/error.h"
 #include "volume/input_ranges.h"
 #include "volume/strict_json.h"
+#include "volume/math_constants.h"
 
 namespace sslpv {
 namespace {
 
 using nlohmann::json;
 
-constexpr double kPi = 3.14159265358979323846;
 
 /// The two axes across `axis`, in cyclic order (x: y, z; y: z, x; z: x, y).
 int across(int axis, int which) { return (axis + 1 + which) % 3; }

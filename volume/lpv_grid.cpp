@@ -10,6 +10,7 @@
 #include "volume/error.h"
 #include "volume/lpv_constants.h"
 #include "volume/mesh.h"
+#include "volume/sh.h"
 
 namespace sslpv {
 
@@ -105,6 +106,16 @@ void ShGrid::resize(const GridFrame& f) {
 
 void ShGrid::clear() {
   for (auto& p : planes) std::fill(p.begin(), p.end(), 0.0f);
+}
+
+glm::dvec3 gridPower(const ShGrid& grid) {
+  glm::dvec3 power(0.0);
+  for (int ch = 0; ch < 3; ++ch) {
+    double sum = 0.0;
+    for (float c0 : grid.planes[ch * 4]) sum += c0;
+    power[ch] = sum * sh::kFluxPerC0;
+  }
+  return power;
 }
 
 }  // namespace sslpv

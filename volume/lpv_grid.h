@@ -105,4 +105,7 @@ struct ShGrid {
   const float* plane(int channel, int sh) const { return planes[channel * 4 + sh].data(); }
 };
 
+/// The power a light field holds, per channel: Σ c0 times the flux per unit of c0.
+glm::dvec3 gridPower(const ShGrid& grid);
+
 }  // namespace sslpv

@@ -359,16 +359,6 @@ bool hasLinearBand(const ShGrid& field) {
   return false;
 }
 
-glm::dvec3 gridPower(const ShGrid& grid) {
-  glm::dvec3 power(0.0);
-  for (int ch = 0; ch < 3; ++ch) {
-    double sum = 0.0;
-    for (float c0 : grid.planes[ch * 4]) sum += c0;
-    power[ch] = sum * sh::kFluxPerC0;
-  }
-  return power;
-}
-
 }  // namespace
 
 void addInjected(const std::array<std::vector<float>, 3>& freshGain, const ShGrid& injected, ShGrid& accumulated) {

@@ -2,11 +2,11 @@
 
 #include <cmath>
 #include <cstddef>
+#include "volume/math_constants.h"
 
 namespace sslpv {
 
 Quadrature gaussLegendreUnit(int n) {
-  constexpr double kPi = 3.14159265358979323846;
   Quadrature q;
   q.x.resize(std::size_t(n));
   q.w.resize(std::size_t(n));

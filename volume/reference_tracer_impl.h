@@ -15,12 +15,12 @@
 #include "volume/refracted_connection.h"
 #include "volume/scene.h"
 #include "volume/scene_object.h"
+#include "volume/math_constants.h"
 
 namespace sslpv {
 
 namespace reference_detail {
 
-constexpr double kPi = 3.14159265358979323846;
 // A box has 6 planes, all tried at every vertex; a curved mesh has about as many as
 // triangles and gets the walk over its faces instead (facetedLight).
 constexpr std::size_t kMaxConnectionPlanes = 64;

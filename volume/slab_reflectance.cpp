@@ -13,11 +13,11 @@
 #include "volume/quadrature.h"
 #include "volume/reference_tracer.h"
 #include "volume/scene.h"
+#include "volume/math_constants.h"
 
 namespace sslpv {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 }  // namespace
 
