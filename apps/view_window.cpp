@@ -33,8 +33,9 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Animation: a scene with deformers plays (sslpv::sceneAtTime poses it); a static scene's
-// time keys (Space, Left, Right) do nothing.
+// Animation: a scene with deformers plays (the render thread's backend is posed at each new
+// time, keeping its grid and warm light); a static scene's time keys (Space, Left, Right)
+// do nothing.
 bool sceneIsAnimated(const Scene& scene) { return !scene.deformers.empty(); }
 
 constexpr auto kPollInterval = std::chrono::milliseconds(500);  // how often the files' mtimes are read
@@ -71,6 +72,7 @@ class Backend final : public FrameRenderer {
   explicit Backend(Args&&... args) : renderer_(std::forward<Args>(args)...) {}
   void setCamera(const Camera& camera) override { renderer_.setCamera(camera); }
   void setLights(const std::vector<Light>& lights) override { renderer_.setLights(lights); }
+  void setTime(double t) override { renderer_.setTime(t); }
   Image render(const LpvSettings& settings, RenderReport* report) override {
     return renderer_.render(settings, report);
   }
@@ -249,8 +251,7 @@ void Viewer::pollFiles(Clock::time_point now) {
 }
 
 void Viewer::timeChanged() {
-  scene_ = controls_.animated() ? std::make_shared<const Scene>(sceneAtTime(*baseScene_, controls_.time()))
-                                : baseScene_;
+  scene_ = baseScene_;
   dirty_ = true;
 }
 
@@ -261,6 +262,7 @@ void Viewer::requestFrame() {
   request.lights = controls_.lights();
   request.settings = controls_.settings();
   request.exposure = args_.exposure;
+  if (controls_.animated()) request.time = controls_.time();
   requested_ = worker_.request(std::move(request));
   dirty_ = false;
 }

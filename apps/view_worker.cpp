@@ -98,6 +98,7 @@ RenderResult RenderWorker::renderOne(std::uint64_t id, const RenderRequest& requ
         rendererScene_ = request.scene;
         camera_.reset();
         lights_.reset();
+        time_.reset();
       } catch (const std::bad_alloc&) {
         throw;
       } catch (const std::exception& e) {
@@ -121,6 +122,10 @@ RenderResult RenderWorker::renderOne(std::uint64_t id, const RenderRequest& requ
     if (!lights_ || !sameLights(*lights_, request.lights)) {
       renderer_->setLights(request.lights);
       lights_ = request.lights;
+    }
+    if (request.time && time_ != request.time) {
+      renderer_->setTime(*request.time);
+      time_ = request.time;
     }
     const Image image = renderer_->render(request.settings, &result.report);
     result.width = image.width;

@@ -26,6 +26,9 @@ class FrameRenderer {
   virtual ~FrameRenderer() = default;
   virtual void setCamera(const Camera& camera) = 0;
   virtual void setLights(const std::vector<Light>& lights) = 0;
+  /// Poses a deforming scene at time t, keeping the backend and its grid (a no-op for a
+  /// static scene). InputError when the pose folds the mesh.
+  virtual void setTime(double t) = 0;
   virtual Image render(const LpvSettings& settings, RenderReport* report) = 0;
 };
 
@@ -33,9 +36,10 @@ class FrameRenderer {
 using RendererFactory = std::function<std::unique_ptr<FrameRenderer>(const Scene&)>;
 
 struct RenderRequest {
-  /// A new pointer (a reload, another animation time) builds a new backend; the same
-  /// one reuses the cached stages.
+  /// A new pointer (a reload) builds a new backend; the same one reuses the cached stages.
   std::shared_ptr<const Scene> scene;
+  /// The deformers' time (unset: the scene's own); a new time re-poses the same backend.
+  std::optional<double> time;
   Camera camera;
   std::vector<Light> lights;
   LpvSettings settings;
@@ -87,6 +91,7 @@ class RenderWorker {
   std::shared_ptr<const Scene> rendererScene_, failedScene_;
   std::optional<Camera> camera_;
   std::optional<std::vector<Light>> lights_;
+  std::optional<double> time_;
 
   std::thread thread_;  // last: started once everything above exists
 };

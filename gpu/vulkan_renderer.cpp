@@ -89,7 +89,9 @@ void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& repo
   material_.meanChord = meanChordLength(object_.mesh());
   material_.coverage = voxelizer_->readCoverage();
   cellCoverage_ = std::make_unique<Buffer>(uploadCellCoverage(device_, material_));
-  propagator_.reset();
+  // On the same frame (a deformed object's grid spans all its poses) the propagator, its
+  // pipelines and buffers stay: resample() hands it the new factors and active cells.
+  if (!sameFrame) propagator_.reset();
   report.frame = frame;
 }
 
