@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <utility>
@@ -73,6 +74,40 @@ void ProgressLine::finish(const std::string& summary) {
   std::fprintf(stderr, "%s%s: %s (%.1f s)%s\n", terminal_ ? "\r" : "", label_.c_str(), summary.c_str(), elapsed,
                terminal_ ? "            " : "");
   std::fflush(stderr);
+}
+
+WaitNotice::WaitNotice(std::string label, std::chrono::milliseconds delay)
+    : WaitNotice(std::move(label), delay, ::isatty(STDERR_FILENO) == 1, stderr) {}
+
+WaitNotice::WaitNotice(std::string label, std::chrono::milliseconds delay, bool terminal, std::FILE* out) {
+  if (terminal) ticker_ = std::thread([this, label = std::move(label), delay, out] { run(label, delay, out); });
+}
+
+WaitNotice::~WaitNotice() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    finished_ = true;
+  }
+  done_.notify_all();
+  if (ticker_.joinable()) ticker_.join();
+}
+
+void WaitNotice::run(std::string label, std::chrono::milliseconds delay, std::FILE* out) {
+  const auto start = CliClock::now();
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (done_.wait_for(lock, delay, [&] { return finished_; })) return;
+  std::size_t width = 0;
+  do {
+    const double elapsed = std::chrono::duration<double>(CliClock::now() - start).count();
+    const std::string line = label + " ... " + std::to_string(int(elapsed * 10.0) / 10) + "." +
+                             std::to_string(int(elapsed * 10.0) % 10) + " s";
+    width = std::max(width, line.size());
+    std::fprintf(out, "\r%s", line.c_str());
+    std::fflush(out);
+  } while (!done_.wait_for(lock, std::chrono::milliseconds(250), [&] { return finished_; }));
+  // Erased, so that what the command prints next starts on a clean line.
+  std::fprintf(out, "\r%s\r", std::string(width, ' ').c_str());
+  std::fflush(out);
 }
 
 }  // namespace sslpv

@@ -2,8 +2,12 @@
 // What the writing subcommands tell the user besides errors: one "wrote" line per output
 // on stdout, progress of long renders on stderr, and warnings on stderr.
 #include <chrono>
+#include <condition_variable>
 #include <cstddef>
+#include <cstdio>
+#include <mutex>
 #include <string>
+#include <thread>
 
 #include "volume/image_io.h"
 #include "volume/scene.h"
@@ -50,6 +54,29 @@ class ProgressLine {
   bool terminal_;
   int lastPercent_ = -1;
   CliClock::time_point start_ = CliClock::now();
+};
+
+/// A wait whose length cannot be known (the first Vulkan frame compiles the device's
+/// pipelines when Mesa's shader cache lacks them: 4 s on lavapipe, 0.9 s with the cache).
+/// Once it has lasted `delay`, on a terminal, a line "LABEL ... N.N s" ticks until the
+/// object is destroyed, which erases it. Nothing off a terminal (logs get the command's
+/// own summary line) or for a shorter wait.
+class WaitNotice {
+ public:
+  explicit WaitNotice(std::string label, std::chrono::milliseconds delay = std::chrono::seconds(1));
+  /// `terminal` forces the mode and `out` the stream (tests); the default asks isatty(stderr).
+  WaitNotice(std::string label, std::chrono::milliseconds delay, bool terminal, std::FILE* out);
+  ~WaitNotice();
+  WaitNotice(const WaitNotice&) = delete;
+  WaitNotice& operator=(const WaitNotice&) = delete;
+
+ private:
+  void run(std::string label, std::chrono::milliseconds delay, std::FILE* out);
+
+  std::mutex mutex_;
+  std::condition_variable done_;
+  bool finished_ = false;
+  std::thread ticker_;
 };
 
 }  // namespace sslpv

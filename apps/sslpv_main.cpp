@@ -183,6 +183,9 @@ int runRender(const RenderArgs& args) {
   std::unique_ptr<gpu::VulkanDevice> device;
 #endif
   std::unique_ptr<FrameRenderer> renderer;
+  // The first Vulkan frame compiles the device's pipelines unless Mesa's shader cache has
+  // them (4 s on lavapipe with an empty cache): a terminal sees the wait, not silence.
+  std::optional<WaitNotice> firstFrame;
 #ifdef SSLPV_HAVE_VULKAN
   if (args.backend != "cpu") {
     try {
@@ -200,6 +203,7 @@ int runRender(const RenderArgs& args) {
     }
   }
   if (device) {
+    firstFrame.emplace("render: preparing the Vulkan pipelines");
     try {
       renderer = std::make_unique<VulkanFrameRenderer>(scene, *device);
     } catch (const GpuError& e) {
@@ -229,6 +233,7 @@ int runRender(const RenderArgs& args) {
 #endif
       if (i > 0) renderer->setTime(frames[i].first);
       image = renderer->render(settings, report);
+      firstFrame.reset();
 #ifdef SSLPV_HAVE_VULKAN
     } catch (const GpuError& e) {
       throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
