@@ -20,6 +20,7 @@
 #include "bench/device_peaks.h"
 #include "gpu/device.h"
 #include "gpu/vulkan_renderer.h"
+#include "bench/int_list.h"
 #include "volume/cpu_renderer.h"
 #include "volume/scene.h"
 
@@ -112,13 +113,7 @@ int main(int argc, char** argv) {
     };
     if (a == "--scene") o.scene = next();
     else if (a == "--grid") {
-      o.grids.clear();
-      const std::string list = next();
-      for (std::size_t at = 0; at != std::string::npos;) {
-        const std::size_t comma = list.find(',', at);
-        o.grids.push_back(std::stoi(list.substr(at, comma == std::string::npos ? comma : comma - at)));
-        at = comma == std::string::npos ? comma : comma + 1;
-      }
+      o.grids = bench::parseIntList(next());
     } else if (a == "--repeats") o.repeats = std::max(1, std::stoi(next()));
     else if (a == "--warmup") o.warmup = std::max(0, std::stoi(next()));
     else if (a == "--backend") {

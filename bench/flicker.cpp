@@ -19,6 +19,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "bench/int_list.h"
 #include "volume/cpu_renderer.h"
 #include "volume/scene.h"
 #include "volume/temporal_metrics.h"
@@ -77,13 +78,7 @@ int main(int argc, char** argv) {
     };
     if (a == "--scene") scenePath = next();
     else if (a == "--grid") {
-      grids.clear();
-      std::string list = next();
-      for (std::size_t at = 0; at != std::string::npos;) {
-        const std::size_t comma = list.find(',', at);
-        grids.push_back(std::stoi(list.substr(at, comma == std::string::npos ? comma : comma - at)));
-        at = comma == std::string::npos ? comma : comma + 1;
-      }
+      grids = bench::parseIntList(next());
     } else if (a == "--frames") frames = std::max(3, std::stoi(next()));
     else if (a == "--step-deg") stepDeg = std::stod(next());
     else if (a == "--size") size = std::stoi(next());
