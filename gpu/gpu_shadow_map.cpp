@@ -8,7 +8,7 @@
 namespace sslpv::gpu {
 namespace {
 
-constexpr std::uint32_t kBindings = 6;  // see the bindings of shaders/shadow_map.{vert,comp}
+constexpr std::uint32_t kBindings = 7;  // see the bindings of shaders/shadow_map.{vert,comp}
 constexpr VkFormat kTriangleFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkBufferUsageFlags kStorage =
@@ -111,8 +111,10 @@ void GpuShadowMapper::setLights(const std::vector<Light>& lights, double ior) {
   }
   if (samples_.size() < sampleBytes) {
     samples_ = Buffer(device_, sampleBytes, kStorage, MemoryUse::Device);
+    rasterIds_ = Buffer(device_, idBytes, kStorage, MemoryUse::Device);
     triangleIds_ = Buffer(device_, idBytes, kStorage, MemoryUse::Device);
     sets_.write(0, 3, triangleIds_);
+    sets_.write(0, 6, rasterIds_);
     sets_.write(0, 4, samples_);
   }
   sets_.write(0, 0, mesh_.positions());
@@ -161,10 +163,10 @@ void GpuShadowMapper::record(VkCommandBuffer cmd, TimestampQueries* timestamps, 
     imageBarrier(cmd, triangleImage_, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                  VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-    copyImageToBuffer(cmd, triangleImage_, triangleIds_, v * texelsPerView * sizeof(std::uint32_t));
+    copyImageToBuffer(cmd, triangleImage_, rasterIds_, v * texelsPerView * sizeof(std::uint32_t));
   }
   if (!views_.empty()) {
-    // The resolve reads the copied ids and writes back the triangle each ray crosses.
+    // The resolve reads the copied raster ids and writes the triangle each ray crosses.
     pipelineMemoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     resolvePipeline_.bind(cmd, set);

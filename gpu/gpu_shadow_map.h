@@ -89,7 +89,9 @@ class GpuShadowMapper {
   ComputePipeline resolvePipeline_;
   StorageBufferSets sets_;
   Image2D triangleImage_, depthImage_;
-  Buffer viewRecords_, triangleIds_, samples_;
+  // rasterIds_: what the rasterizer saw per texel; triangleIds_: what the resolve found the
+  // texel's ray crosses (separate, so the resolve reads neighbours' raster ids race-free).
+  Buffer viewRecords_, rasterIds_, triangleIds_, samples_;
   CommandContext commands_;
   TimestampQueries timestamps_;
 };

@@ -31,7 +31,7 @@ inline double meanLitRadiance(const Image& image) {
 }
 
 /// Renders `scene` (with `set` painted in when given) on both backends and expects the
-/// images to agree: mean relative difference <= 1 %, every interior pixel within 8 %
+/// images to agree: mean relative difference <= 1 %, every interior pixel within 2 %
 /// (relative to max(cpu, 1e-3 x the mean)), edge pixels <= 1 % and background mismatches
 /// <= 0.1 % of the object, the same occupied cells, no surface mismatch.
 /// With `moveTo` (a deforming scene), both renderers first render a frame at scene.time,
@@ -72,11 +72,10 @@ inline void expectGpuAgreement(const Scene& scene, const gpu::VulkanDevice& devi
   ASSERT_GT(a.interior, cpuImage.pixels.size() / 100) << "the object must be in view, or nothing is compared";
   EXPECT_EQ(gpuReport.activeCells, cpuReport.activeCells) << "both backends must see the same occupied cells";
   EXPECT_LE(a.meanRelative, 0.01);
-  // The single-scattering term makes hard choices per sample (the nearest shadow-map
-  // texel, whether a sample is still inside), and the two backends' shadow maps differ
-  // in float rounding, so a choice can flip at a pixel: measured 6.8 % at one pixel of
-  // random2 (under 1.1 % everywhere else), with the mean below 0.11 %.
-  EXPECT_LE(a.worstInterior, 0.08);
+  // Measured 2026-12-04 over the examples and 32 random scenes: worst interior pixel
+  // 0.74 % (skin_sphere). It was up to 14.5 % while the GPU shadow map dropped silhouette
+  // texels the rasterizer snapped out (ASilhouetteTexelTheRasterizerLeavesEmpty...).
+  EXPECT_LE(a.worstInterior, 0.02);
   EXPECT_LE(double(a.edge), 0.01 * double(a.objectPixels));
   EXPECT_LE(double(a.backgroundMismatches), 0.001 * double(a.objectPixels));
   EXPECT_EQ(a.surfaceMismatches, 0u);

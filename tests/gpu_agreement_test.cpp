@@ -4,7 +4,7 @@
 // Pixel classes as in image_agreement.h (silhouette and edge pixels are where the
 // rasterizer and the ray caster may see different triangles). Expectations:
 // - mean relative difference over all object pixels (silhouette and edge included) ≤ 1 %;
-// - every interior pixel within 3 % per channel, relative to max(cpu, 1e-3 × the
+// - every interior pixel within 2 % per channel, relative to max(cpu, 1e-3 × the
 //   object's mean radiance) so that barely lit pixels are not judged by their ratio;
 // - edge pixels at most 1 % of the object; the surface agrees off the silhouette;
 //   "background mismatches" (a pixel lit in one image whose whole 3x3 neighbourhood is
@@ -113,6 +113,24 @@ std::string randomScene(std::mt19937& rng) {
     << "], \"target\": [0, 0, 0], \"fov_y_deg\": 35, \"width\": 96, \"height\": 96}, \"lpv\": {\"resolution\": "
     << 16 + int(rng() % 17) << ", \"steps\": " << 4 + int(rng() % 9) << ", \"shadow_map\": 128}}";
   return s.str();
+}
+
+TEST_F(GpuAgreement, ASilhouetteTexelTheRasterizerLeavesEmptyIsLitOnBothBackends) {
+  // A box lit through a coarse 46-texel shadow map (random scene 9004 as clang drew it,
+  // before tests/random_scenes.h fixed its draw order). One texel centre lay within the
+  // rasterizer's vertex snapping outside a silhouette edge: the CPU's ray hit the box, the
+  // rasterizer left the texel empty, and that texel's light (1/2116 of the map) went into
+  // one backend's lattice only: 14.5 % brighter red on a cluster of pixels. The resolve
+  // now tries the triangles its neighbouring texels rasterized.
+  const char* json =
+      R"({"units": "mm",
+       "mesh": {"primitive": "box", "min": [-3.917798391493467, -2.8301265679536916, -5.292081002161506], "max": [3.917798391493467, 2.8301265679536916, 5.292081002161506]},
+       "transform": {"translate": [-4.92846621805166, -4.31273105904204, -0.19426802996475345], "rotate_deg": [-26.15183673828335, 77.40229534966966, 25.557050429386322], "scale": 1},
+       "material": {"base": {"sigma_t": [29.9302, 1.32846, 0.0315634], "sigma_s": [8.09106, 0.127954, 0.0130681], "g": -0.4444363512667717}, "ior": 1},
+       "lights": [{"type": "directional", "direction": [8.53385769786378, -1.4155262557840695, 36.79028079153937], "irradiance": [1.0385615456761652, 1.0385615456761652, 1.0385615456761652]}],
+       "camera": {"position": [-32.98644723565975, 1.684302645692144, 8.449771812915882], "target": [-4.92846621805166, -4.31273105904204, -0.19426802996475345], "fov_y_deg": 49.14505240655264, "width": 64, "height": 64},
+       "lpv": {"resolution": 9, "steps": "auto", "shadow_map": 46, "scheme": "calibrated"}})";
+  expectAgreement(parseScene(json, "silhouette_texel.json"));
 }
 
 TEST_F(GpuAgreement, RandomizedSmallScenes) {

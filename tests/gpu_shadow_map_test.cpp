@@ -8,11 +8,14 @@
 //
 // Tolerances, and why:
 // - Hit or miss: the rasterizer decides coverage at the texel centre in fixed point, the
-//   ray caster in float, so they may disagree where the centre lies within rounding of a
-//   silhouette (or of a spot's cone edge). A texel is a silhouette texel when its 3x3
+//   ray caster in float; the resolve re-tests both ways with the exact ray (a covered
+//   texel whose ray crosses nothing is dropped, an empty one whose ray crosses a triangle
+//   its neighbours rasterized is taken), so only Embree's own float test can still differ
+//   from the shared crossing test there. A texel is a silhouette texel when its 3x3
 //   neighbourhood (within its view) in the CPU map holds both hits and misses. Every
-//   other texel must agree exactly; silhouette disagreements must stay below 2 % of the
-//   silhouette texels.
+//   other texel must agree exactly; silhouette disagreements at most one per view set or
+//   0.1 % of the silhouette texels (measured 2026-12-04: 1 of 2106 in the box's cube map,
+//   none elsewhere; 5 in all before the resolve took empty texels).
 // - Where both hit, both intersect the same triangle's plane in float. The hit distance
 //   along a ray is ill-conditioned by 1/cos θi at grazing incidence, so positions must
 //   agree within |Δp| cos θi <= 1e-5 of the object's radius.
@@ -226,7 +229,7 @@ void expectAgreement(const Agreement& a, const std::string& what) {
             << a.gpuFlux.x << "\n";
   EXPECT_GT(a.cpuHits, 1000u) << what << ": the case should light a good part of the map";
   EXPECT_EQ(a.otherMismatches, 0u) << what;
-  EXPECT_LE(double(a.silhouetteMismatches), 0.02 * double(a.silhouette)) << what;
+  EXPECT_LE(double(a.silhouetteMismatches), std::max(1.0, 1e-3 * double(a.silhouette))) << what;
   EXPECT_LE(double(a.otherTriangleOffEdge), std::max(3.0, 2e-4 * double(a.common))) << what;
   EXPECT_LE(double(a.otherTriangle), 0.001 * double(a.common)) << what;
   EXPECT_LE(a.worstPosition, 1e-5) << what;
