@@ -10,6 +10,7 @@
 #include <random>
 
 #include "editor/stroke_io.h"
+#include "seeded_draws.h"
 #include "test_meshes.h"
 #include "volume/error.h"
 
@@ -18,6 +19,7 @@ namespace {
 
 using openvdb::Coord;
 using openvdb::Vec3s;
+using test::drawVec3;
 
 const MaterialSample kBase{{1.0f, 1.2f, 1.4f}, {0.9f, 1.0f, 1.1f}, 0.1f};
 
@@ -91,8 +93,8 @@ std::shared_ptr<MaterialSet> randomSet(std::uint32_t seed) {
   auto g = set->g->getAccessor();
   for (auto it = openvdb::CoordBBox(Coord(-12), Coord(12)).begin(); it; ++it) {
     const float r = unit(rng);
-    const Vec3s st(5 * unit(rng), 5 * unit(rng), 5 * unit(rng));
-    const Vec3s ss(st[0] * unit(rng), st[1] * unit(rng), st[2] * unit(rng));
+    const Vec3s st = drawVec3<Vec3s>([&] { return 5 * unit(rng); });
+    const Vec3s ss = st * drawVec3<Vec3s>(unit, rng);
     if (r < 0.3f) {
       t.setValueOn(*it, st);
       s.setValueOn(*it, ss);
@@ -343,14 +345,15 @@ TEST(BrushEngine, RandomStrokesKeepEveryVoxelValid) {
     b.channel =
         valued ? BrushChannel(pick(b.mode == BrushMode::Set ? 5 : 3)) : BrushChannel(pick(4) == 3 ? 5 : pick(3));
     if (b.mode == BrushMode::Set && pick(6) == 0) b.channel = BrushChannel::Colour;
-    b.artist.colour = glm::dvec3(unit(rng), unit(rng), unit(rng));
-    b.artist.scatterDistance = glm::dvec3(value(false) + 1e-6, 1e-3 + unit(rng), 0.5);
+    b.artist.colour = drawVec3<glm::dvec3>(unit, rng);
+    const double scatterY = 1e-3 + unit(rng);  // drawn before x, as GCC did (seeded_draws.h)
+    b.artist.scatterDistance = glm::dvec3(value(false) + 1e-6, scatterY, 0.5);
     b.artist.g = 1.98 * unit(rng) - 0.99;
-    b.rgb =
-        glm::dvec3(value(b.mode == BrushMode::Add), value(b.mode == BrushMode::Add), value(b.mode == BrushMode::Add));
+    b.rgb = drawVec3<glm::dvec3>([&] { return value(b.mode == BrushMode::Add); });
     b.scalar = b.mode == BrushMode::Set ? 1.98 * unit(rng) - 0.99 : value(true);
-    b.albedo = glm::dvec3(unit(rng), unit(rng), unit(rng));
-    b.meanFreePath = glm::dvec3(1e-3 + unit(rng), 0.5, 1e-6 + 4 * unit(rng));
+    b.albedo = drawVec3<glm::dvec3>(unit, rng);
+    const double meanFreePathZ = 1e-6 + 4 * unit(rng);  // drawn before x, as GCC did (seeded_draws.h)
+    b.meanFreePath = glm::dvec3(1e-3 + unit(rng), 0.5, meanFreePathZ);
     b.preset = measuredMaterials()[std::size_t(pick(11))].name;
     b.radius = 0.3 + 2.5 * unit(rng);
     b.falloff = BrushFalloff(pick(4));
@@ -359,7 +362,7 @@ TEST(BrushEngine, RandomStrokesKeepEveryVoxelValid) {
     ASSERT_EQ(brushProblem(b), "") << i;
     std::vector<glm::dvec3> points;
     for (int p = 0, n = 1 + pick(3); p < n; ++p)
-      points.push_back(glm::dvec3(unit(rng), unit(rng), unit(rng)) * 12.0 - 6.0);
+      points.push_back(drawVec3<glm::dvec3>(unit, rng) * 12.0 - 6.0);
     engine->applyStroke({b, points, {}});
   }
   std::size_t active = 0;

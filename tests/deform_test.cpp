@@ -7,6 +7,7 @@
 #include <random>
 #include <string>
 
+#include "seeded_draws.h"
 #include "volume/cpu_renderer.h"
 #include "volume/deform.h"
 #include "volume/error.h"
@@ -71,7 +72,7 @@ TEST(Deformers, InverseUndoesForwardForEveryTypeAndAxis) {
     for (int axis = 0; axis < 3; ++axis)
       for (int trial = 0; trial < 40; ++trial) {
         const int toward = (axis + 1 + (trial % 2)) % 3;
-        const glm::dvec3 center(unit(rng), unit(rng), unit(rng));
+        const glm::dvec3 center = test::drawVec3<glm::dvec3>(unit, rng);
         double k = 0.0;
         switch (type) {
           case Deformer::Type::Bend: k = 0.6 * unit(rng); break;  // rad per unit: |k v| < 1 within 1.5
@@ -80,7 +81,7 @@ TEST(Deformers, InverseUndoesForwardForEveryTypeAndAxis) {
           case Deformer::Type::SquashStretch: k = std::exp(1.5 * unit(rng)); break;
         }
         const PosedDeformer d = posed(type, axis, toward, k, center);
-        const glm::dvec3 p = center + 1.5 * glm::dvec3(unit(rng), unit(rng), unit(rng));
+        const glm::dvec3 p = center + 1.5 * test::drawVec3<glm::dvec3>(unit, rng);
         ASSERT_TRUE(d.outsideDomain(p).empty()) << d.outsideDomain(p);
         const glm::dvec3 q = d.forward(p);
         const glm::dvec3 back = d.inverse(q);
@@ -135,7 +136,7 @@ TEST(Deformers, AStackInvertsInReverseOrder) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> along(0.0, 2.0), across(-0.25, 0.25);
   for (int i = 0; i < 200; ++i) {
-    const glm::dvec3 p(along(rng), across(rng), across(rng));
+    const glm::dvec3 p = test::drawVec3<glm::dvec3>(along, across, across, rng);
     EXPECT_LT(glm::length(pose.inverse(pose.forward(p)) - p), 1e-12);
   }
 }

@@ -28,6 +28,7 @@
 
 #include "gpu_test_fixture.h"
 #include "lpv_test_grids.h"
+#include "seeded_draws.h"
 #include "test_meshes.h"
 #include "volume/sh.h"
 #include "volume/voxelize.h"
@@ -57,7 +58,7 @@ MaterialGrid sphereMaterial(int resolution) {
 glm::vec3 randomUnit(std::mt19937& rng) {
   std::normal_distribution<float> normal;
   glm::vec3 v;
-  do v = glm::vec3(normal(rng), normal(rng), normal(rng));
+  do v = drawVec3<glm::vec3>(normal, rng);
   while (glm::length(v) < 1e-3f);
   return glm::normalize(v);
 }
@@ -76,7 +77,7 @@ std::vector<GpuFluxSample> randomSamples(std::size_t count, unsigned seed, doubl
     const float kind = uniform(rng);
     glm::vec3 position, normal = u;
     float valid = 1.0f;
-    glm::vec3 flux(uniform(rng), uniform(rng), uniform(rng));
+    glm::vec3 flux = drawVec3<glm::vec3>(uniform, rng);
     flux *= 0.01f;
     if (kind < 0.75f) {
       position = kCenter + kRadius * (0.95f + 0.1f * uniform(rng)) * u;

@@ -17,6 +17,7 @@
 #include "gpu/compute.h"
 #include "gpu_test_fixture.h"
 #include "lpv_test_grids.h"
+#include "seeded_draws.h"
 #include "volume/error.h"
 
 namespace {
@@ -187,7 +188,7 @@ RandomCase randomCase(std::mt19937& rng) {
   RandomCase c;
   MaterialGrid& m = c.material;
   m.frame.cellSize = 0.1 + unit(rng);
-  m.frame.dims = glm::ivec3(dim(rng), dim(rng), dim(rng));
+  m.frame.dims = drawVec3<glm::ivec3>(dim, rng);
   const std::size_t n = m.frame.cellCount();
   const float holes = 0.4f * unit(rng);
   m.coverage.resize(n);
@@ -212,7 +213,7 @@ RandomCase randomCase(std::mt19937& rng) {
     const int x = int(unit(rng) * m.frame.dims.x), y = int(unit(rng) * m.frame.dims.y),
               z = int(unit(rng) * m.frame.dims.z);
     if (!m.frame.contains(x, y, z) || !isActiveCell(m, x, y, z)) continue;  // injection's contract
-    glm::vec3 dir(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f);
+    const glm::vec3 dir = drawVec3<glm::vec3>([&] { return unit(rng) - 0.5f; });
     if (glm::length(dir) < 1e-3f) continue;
     putLobe(c.injected, x, y, z, glm::normalize(dir), 0.1f + 10.0f * unit(rng));
     ++placed;

@@ -12,6 +12,7 @@
 #include <random>
 #include <string>
 
+#include "seeded_draws.h"
 #include "test_support.h"
 #include "volume/error.h"
 
@@ -19,6 +20,7 @@ namespace sslpv {
 namespace {
 
 namespace fs = std::filesystem;
+using test::drawVec3;
 using test::readText;
 using test::TempDir;
 using test::writeText;
@@ -29,7 +31,10 @@ Image makeHdrImage(int width, int height, unsigned seed) {
   Image image(width, height);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  for (auto& p : image.pixels) p = glm::vec3(unit(rng) * 1e4f, unit(rng) * 1e-6f, unit(rng) + 1.0f / 3.0f);
+  for (auto& p : image.pixels) {
+    const glm::vec3 u = drawVec3<glm::vec3>(unit, rng);
+    p = glm::vec3(u.x * 1e4f, u.y * 1e-6f, u.z + 1.0f / 3.0f);
+  }
   return image;
 }
 

@@ -9,6 +9,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "seeded_draws.h"
 #include "volume/image_metrics.h"
 
 namespace sslpv {
@@ -147,7 +148,7 @@ TEST(ImageMetrics, RelativeMetricsDoNotDependOnExposure) {
   Image a = b;
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(0.0f, 0.05f);
-  for (glm::vec3& p : a.pixels) p *= glm::vec3(1.0f + noise(rng), 1.0f + noise(rng), 1.0f + noise(rng));
+  for (glm::vec3& p : a.pixels) p *= test::drawVec3<glm::vec3>([&] { return 1.0f + noise(rng); });
   Image a1000 = a, b1000 = b;
   for (glm::vec3& p : a1000.pixels) p *= 1024.0f;  // a power of two: exact in float
   for (glm::vec3& p : b1000.pixels) p *= 1024.0f;

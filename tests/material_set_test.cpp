@@ -13,6 +13,7 @@
 #include <random>
 #include <sstream>
 
+#include "seeded_draws.h"
 #include "test_support.h"
 #include "volume/error.h"
 
@@ -21,6 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using openvdb::Coord;
 using openvdb::Vec3s;
+using test::drawVec3;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -362,7 +364,7 @@ MaterialSet largerSet() {
   auto s = set.sigmaS->getAccessor();
   auto g = set.g->getAccessor();
   for (int i = 0; i < 4000; ++i) {
-    Coord xyz(int(rng() % 48), int(rng() % 48), int(rng() % 48));
+    Coord xyz = drawVec3<Coord>([&] { return int(rng() % 48); });
     float v = 1.0f + float(rng() % 1000) / 100.0f;
     t.setValue(xyz, Vec3s(v, v * 1.5f, v * 2.0f));
     s.setValue(xyz, Vec3s(v * 0.5f, v, v));
@@ -556,7 +558,7 @@ TEST(MaterialFieldSample, MatchesOpenVdbTransformAndBoxSamplerInsideActiveRegion
   openvdb::tools::GridSampler<openvdb::Vec3SGrid, openvdb::tools::BoxSampler> reference(*sigmaT);
   std::uniform_real_distribution<double> inside(0.5, 9.5);
   for (int n = 0; n < 50; ++n) {
-    const openvdb::Vec3d index(inside(rng), inside(rng), inside(rng));
+    const openvdb::Vec3d index = drawVec3<openvdb::Vec3d>(inside, rng);
     const openvdb::Vec3d world = sigmaT->transform().indexToWorld(index);
     const Vec3s expected = reference.wsSample(world);
     EXPECT_NEAR(sampler.sample({world[0], world[1], world[2]}).sigmaT.x, expected[0], 2e-5);

@@ -12,6 +12,7 @@
 
 #include "monte_carlo.h"
 #include "random_scenes.h"
+#include "seeded_draws.h"
 #include "volume/cpu_renderer.h"
 #include "volume/lpv_calibration.h"
 #include "volume/lpv_constants.h"
@@ -244,8 +245,7 @@ TEST(Property, PathTracerTransmittanceWithinItsErrorBars) {
     // Optical depths 0.05..2.5: deeper, 10^4 samples of a transmittance under 0.08 are
     // too noisy (the SE bound) to say anything.
     const double d = r.logUniform(0.05, 2.0);
-    const glm::dvec3 sigmaT =
-        glm::dvec3(r.logUniform(0.05, 2.5), r.logUniform(0.05, 2.5), r.logUniform(0.05, 2.5)) / d;
+    const glm::dvec3 sigmaT = drawVec3<glm::dvec3>([&] { return r.logUniform(0.05, 2.5); }) / d;
     const double majorant = r.uniform(1.2, 4.0) * std::max({sigmaT.x, sigmaT.y, sigmaT.z});
     const ReferenceTracer tracer(slab(d, sigmaT, glm::dvec3(0.0), 0.0, 1.0), distantDenseVoxel(majorant), global);
     for (int c = 0; c < 3; ++c) {

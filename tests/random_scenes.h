@@ -7,6 +7,7 @@
 // (a generator drifting out of the accepted ranges fails loudly there, not silently).
 #include <openvdb/openvdb.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <iterator>
@@ -40,6 +41,16 @@ class SceneRandom {
     const double u = uniform(0.0, 1.0);
     return u < 0.1 ? 0.0 : u > 0.9 ? 1.0 : uniform(0.0, 1.0);
   }
+  /// Three draws for one vector, made in a fixed order. Function arguments are evaluated in
+  /// an unspecified order (GCC right to left, clang left to right), so drawing inside one
+  /// call's argument list gave each compiler a different scene for the same seed. The last
+  /// component is drawn first, as GCC did, so every seed keeps the scene its tests were
+  /// written against.
+  template <typename Draw>
+  auto triple(Draw draw) {
+    const auto z = draw(), y = draw(), x = draw();
+    return std::array<decltype(z), 3>{x, y, z};
+  }
   std::mt19937_64& engine() { return rng_; }
 
  private:
@@ -70,7 +81,8 @@ inline std::shared_ptr<const MaterialSet> randomMaterialSet(SceneRandom& r, doub
   const int reach = int(std::ceil(extent / voxel));
   const int count = r.integer(1, 300);
   for (int k = 0; k < count; ++k) {
-    const openvdb::Coord ijk(r.integer(-reach, reach), r.integer(-reach, reach), r.integer(-reach, reach));
+    const auto cell = r.triple([&] { return r.integer(-reach, reach); });
+    const openvdb::Coord ijk(cell[0], cell[1], cell[2]);
     openvdb::Vec3s t, s;
     for (int c = 0; c < 3; ++c) {
       t[c] = float(r.logUniform(0.01, 50.0));
@@ -105,8 +117,9 @@ inline RandomScene randomScene(std::uint64_t seed, int side) {
   }
   const double scale = r.chance(0.5) ? r.logUniform(0.5, 2.0) : 1.0;
   const double cx = r.uniform(-5, 5), cy = r.uniform(-5, 5), cz = r.uniform(-5, 5);
+  const auto rotation = r.triple([&] { return r.uniform(-180, 180); });
   j << ", \"transform\": {\"translate\": " << vec3Json(cx, cy, cz)
-    << ", \"rotate_deg\": " << vec3Json(r.uniform(-180, 180), r.uniform(-180, 180), r.uniform(-180, 180))
+    << ", \"rotate_deg\": " << vec3Json(rotation[0], rotation[1], rotation[2])
     << ", \"scale\": " << scale << "}";
   const double worldSize = size * scale * std::sqrt(3.0);  // bounding radius
 
@@ -130,10 +143,12 @@ inline RandomScene randomScene(std::uint64_t seed, int side) {
     const double power = r.logUniform(10.0, 1e5);
     if (l) j << ", ";
     switch (r.integer(0, 2)) {
-      case 0:
+      case 0: {
+        const double blue = r.uniform(0, 1), green = r.uniform(0, 1);  // as GCC drew them (see triple)
         j << "{\"type\": \"point\", \"position\": " << vec3Json(cx + x, cy + y, cz + z) << ", \"intensity\": "
-          << vec3Json(power, power * r.uniform(0, 1), power * r.uniform(0, 1)) << "}";
+          << vec3Json(power, power * green, power * blue) << "}";
         break;
+      }
       case 1:
         j << "{\"type\": \"spot\", \"position\": " << vec3Json(cx + x, cy + y, cz + z) << ", \"direction\": " << vec3Json(-x, -y, -z)
           << ", \"fov_deg\": " << r.uniform(10.0, 120.0) << ", \"intensity\": " << vec3Json(power, power, power) << "}";

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "monte_carlo.h"
+#include "seeded_draws.h"
 #include "test_support.h"
 #include "volume/image_io.h"
 #include "volume/majorant_grid.h"
@@ -223,7 +224,7 @@ TEST(ReferenceTracer, BrickBoundsHoldTheFieldEverywhere) {
     };
     const Bounds& box = grid.box();
     for (int i = 0; i < 100000; ++i)
-      check(box.min + glm::dvec3(rng.uniform(), rng.uniform(), rng.uniform()) * (box.max - box.min));
+      check(box.min + drawVec3<glm::dvec3>([&] { return rng.uniform(); }) * (box.max - box.min));
     for (auto it = set->sigmaT->cbeginValueOn(); it; ++it) {
       openvdb::CoordBBox voxels;
       it.getBoundingBox(voxels);
@@ -278,7 +279,7 @@ TEST(ReferenceTracer, HeterogeneousTransmittanceAgreesAcrossMajorantsAndQuadratu
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     const glm::dvec3 dir(r * std::cos(phi), r * std::sin(phi), z);
     const glm::dvec3 through =
-        glm::dvec3(0.7, 0.0, -0.4) + 0.6 * glm::dvec3(chords.uniform(), chords.uniform(), chords.uniform());
+        glm::dvec3(0.7, 0.0, -0.4) + 0.6 * drawVec3<glm::dvec3>([&] { return chords.uniform(); });
     const glm::dvec3 a = through - 20.0 * dir, b = through + 20.0 * dir;
     for (int c = 0; c < 3; ++c) {
       const double exact = std::exp(-opticalDepth(withBricks, a, b, glm::dvec3(-5.0), glm::dvec3(5.0), c));

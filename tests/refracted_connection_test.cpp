@@ -8,6 +8,7 @@
 #include <iostream>
 #include <random>
 
+#include "seeded_draws.h"
 #include "test_meshes.h"
 #include "volume/fresnel.h"
 #include "volume/refracted_connection.h"
@@ -36,7 +37,10 @@ TEST(RefractedConnection, RefractingPointObeysSnell) {
   std::uniform_real_distribution<double> u(-3.0, 3.0);
   for (double eta : {0.8, 1.3, 1.5}) {
     for (int k = 0; k < 50; ++k) {
-      const glm::dvec3 x(u(rng), u(rng), -0.05 - std::abs(u(rng))), light(u(rng), u(rng), 0.05 + std::abs(u(rng)));
+      glm::dvec3 x = drawVec3<glm::dvec3>(u, rng);
+      x.z = -0.05 - std::abs(x.z);
+      glm::dvec3 light = drawVec3<glm::dvec3>(u, rng);
+      light.z = 0.05 + std::abs(light.z);
       const auto c = connectPointLight(x, light, kTop, eta);
       if (!c) {
         ADD_FAILURE() << "no connection for a light above and a point below";

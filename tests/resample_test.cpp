@@ -8,6 +8,7 @@
 #include <iostream>
 #include <random>
 
+#include "seeded_draws.h"
 #include "volume/lpv_grid.h"
 #include "volume/material_set.h"
 
@@ -15,6 +16,7 @@ namespace sslpv {
 namespace {
 using openvdb::Coord;
 using openvdb::Vec3s;
+using test::drawVec3;
 
 const MaterialSample kBase{glm::vec3(2.0f, 3.0f, 4.0f), glm::vec3(1.0f, 1.5f, 2.0f), 0.2f};
 
@@ -118,7 +120,7 @@ std::shared_ptr<MaterialSet> randomSet(std::mt19937& rng, const openvdb::math::T
     for (int j = -1; j < 7; ++j)
       for (int k = -1; k < 7; ++k) {
         if (unit(rng) < 0.3f) continue;  // leave holes that take the base
-        Vec3s t(value(rng), value(rng), value(rng));
+        Vec3s t = drawVec3<Vec3s>(value, rng);
         sigmaT->tree().setValue(Coord(i, j, k), t);
         sigmaS->tree().setValue(Coord(i, j, k), t * unit(rng));
         g->tree().setValue(Coord(i, j, k), unit(rng) * 1.6f - 0.8f);
@@ -164,8 +166,8 @@ TEST(BoxAverage, ExactPathMatchesBruteForceForRandomBoxes) {
   std::uniform_real_distribution<double> x(-6.0, 3.0), y(-2.0, 6.0), z(-1.0, 10.0), size(0.2, 1.2);
   double worst = 0.0;
   for (int box = 0; box < 5; ++box) {
-    const glm::dvec3 lo(x(rng), y(rng), z(rng));
-    const glm::dvec3 hi = lo + glm::dvec3(size(rng), size(rng), size(rng));
+    const glm::dvec3 lo = drawVec3<glm::dvec3>(x, y, z, rng);
+    const glm::dvec3 hi = lo + drawVec3<glm::dvec3>(size, rng);
     const MaterialSample exact = sampler.boxAverage(lo, hi), numeric = bruteForceAverage(sampler, lo, hi, 160);
     expectNear(exact, numeric, 1e-4);
     worst = std::max({worst, double(std::abs(exact.sigmaT.x - numeric.sigmaT.x)),
@@ -189,8 +191,8 @@ TEST(BoxAverage, RotatedTransformAgreesWithBruteForce) {
   std::uniform_real_distribution<double> position(0.0, 4.0), size(0.3, 1.0);
   double worst = 0.0;
   for (int box = 0; box < 5; ++box) {
-    const glm::dvec3 lo(position(rng), position(rng), position(rng));
-    const glm::dvec3 hi = lo + glm::dvec3(size(rng), size(rng), size(rng));
+    const glm::dvec3 lo = drawVec3<glm::dvec3>(position, rng);
+    const glm::dvec3 hi = lo + drawVec3<glm::dvec3>(size, rng);
     const MaterialSample exact = bruteForceAverage(sampler, lo, hi, 96);
     const MaterialSample stratified = sampler.boxAverage(lo, hi);
     expectNear(stratified, exact, 0.05);

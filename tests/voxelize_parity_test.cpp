@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <random>
 
+#include "seeded_draws.h"
 #include "shaders/voxelize_shared.h"
 #include "volume/error.h"
 #include "volume/voxelize.h"
@@ -28,7 +29,7 @@ TEST(VoxelizeParityShared, FloatPlaneCubeCoverageMatchesDoubleReference) {
   std::uniform_real_distribution<double> offset(-0.95, 0.95);
   double worst = 0.0, worstNearAxis = 0.0;
   for (int trial = 0; trial < 20000; ++trial) {
-    glm::dvec3 n(gauss(rng), gauss(rng), gauss(rng));
+    glm::dvec3 n = drawVec3<glm::dvec3>(gauss, rng);
     if (trial % 4 == 0) n.x *= 1e-4;  // near-axis and near-face-diagonal normals
     if (trial % 8 == 0) n.y *= 1e-3;
     n = glm::normalize(n);
@@ -56,7 +57,7 @@ TEST(VoxelizeParityShared, PackedDistanceAndNormalRoundTrip) {
   std::uniform_real_distribution<float> distance(0.0f, SSLPV_VOX_WHOLE_CELL);
   double worstAngle = 0.0, worstDistance = 0.0;
   for (int trial = 0; trial < 20000; ++trial) {
-    const glm::vec3 n = glm::normalize(glm::vec3(gauss(rng), gauss(rng), gauss(rng)));
+    const glm::vec3 n = glm::normalize(drawVec3<glm::vec3>(gauss, rng));
     const float d = distance(rng);
     const std::uint32_t packed = vox::vox_pack(d, vox::vec3(n.x, n.y, n.z));
     ASSERT_NE(packed, SSLPV_VOX_EMPTY);

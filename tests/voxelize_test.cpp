@@ -7,11 +7,13 @@
 #include <numeric>
 #include <random>
 
+#include "seeded_draws.h"
 #include "test_meshes.h"
 
 namespace sslpv {
 namespace {
 
+using test::drawVec3;
 using test::enclosedVolume;
 using test::makeBoxMesh;
 using test::makeIcosphere;
@@ -53,7 +55,7 @@ TEST(PlaneCubeCoverage, MatchesLatticeCountForObliquePlanes) {
   std::normal_distribution<double> gauss;
   std::uniform_real_distribution<double> offset(-0.9, 0.9);
   for (int trial = 0; trial < 40; ++trial) {
-    const glm::dvec3 n = glm::normalize(glm::dvec3(gauss(rng), gauss(rng), gauss(rng)));
+    const glm::dvec3 n = glm::normalize(drawVec3<glm::dvec3>(gauss, rng));
     const double d = offset(rng);
     // 100^3 lattice points: counting error well below 1e-2 for any plane.
     EXPECT_NEAR(planeCubeCoverage(d, n), latticeCubeFraction(d, n, 100), 1e-2)
