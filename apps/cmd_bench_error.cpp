@@ -22,15 +22,10 @@
 #include <string>
 #include <vector>
 
-#ifdef SSLPV_HAVE_VULKAN
-#include "gpu/device.h"
-#include "gpu/vk_check.h"
-#include "gpu/vulkan_renderer.h"
-#endif
 #include "apps/cli_output.h"
+#include "backend/backends.h"
 #include "volume/atomic_file.h"
 #include "volume/bench_table.h"
-#include "volume/cpu_renderer.h"
 #include "volume/error.h"
 #include "volume/image_io.h"
 #include "volume/image_metrics.h"
@@ -44,12 +39,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-#ifdef SSLPV_HAVE_VULKAN
-using Device = gpu::VulkanDevice;
-#else
-struct Device {};
-#endif
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -179,30 +168,19 @@ struct Frame {
 
 /// One full render from a fresh renderer: the constructor (mesh load, BVH, upload) is
 /// outside the timed region, render() (voxelize through shading) inside.
-Frame renderFresh(const Scene& scene, const BenchConfig& config, const Device* device) {
+Frame renderFresh(const Scene& scene, const BenchConfig& config, Backends* vulkan) {
   const LpvSettings settings = config.apply(scene.lpv);
-  Frame frame;
-  if (config.backend == "cpu") {
-    CpuRenderer renderer(scene);
-    const auto start = Clock::now();
-    frame.image = renderer.render(settings, &frame.report);
-    frame.wallMs = 1000.0 * secondsSince(start);
-    return frame;
-  }
-#ifdef SSLPV_HAVE_VULKAN
+  std::unique_ptr<Renderer> renderer;
   try {
-    gpu::VulkanRenderer renderer(scene, *device);
-    const auto start = Clock::now();
-    frame.image = renderer.render(settings, &frame.report);
-    frame.wallMs = 1000.0 * secondsSince(start);
-    return frame;
-  } catch (const GpuError& e) {
-    throw ResourceError(scene.file.string() + ": --backend vulkan: " + e.what());
+    renderer = config.backend == "cpu" ? makeRenderer(scene, BackendKind::Cpu) : vulkan->make(scene);
+  } catch (const ResourceError& e) {
+    throw ResourceError(scene.file.string() + ": " + e.what());
   }
-#else
-  (void)device;
-  throw std::logic_error("vulkan configuration without a Vulkan build");
-#endif
+  Frame frame;
+  const auto start = Clock::now();
+  frame.image = renderer->render(settings, &frame.report);
+  frame.wallMs = 1000.0 * secondsSince(start);
+  return frame;
 }
 
 ImageMetrics measure(const std::string& sceneArg, const Image& render, const Image& reference, int block) {
@@ -225,18 +203,18 @@ ImageMetrics measure(const std::string& sceneArg, const Image& render, const Ima
 }
 
 BenchRow runConfig(const std::string& sceneArg, const Scene& scene, const BenchConfig& config,
-                   const Image& reference, const BenchErrorArgs& args, const Device* device) {
+                   const Image& reference, const BenchErrorArgs& args, Backends* vulkan) {
   BenchRow row;
   row.scene = sceneArg;
   row.config = config;
   row.repeats = args.repeats;
   // The warm-up pays for first-touch page faults, TBB's thread start and shader JIT; its
   // image is the one measured (renders are deterministic, so any would do).
-  const Frame warm = renderFresh(scene, config, device);
+  const Frame warm = renderFresh(scene, config, vulkan);
   row.stepsRun = warm.report.propagation.stepsRun;
   std::vector<double> vox, res, shadow, inject, prop, shade, total;
   for (int r = 0; r < args.repeats; ++r) {
-    const Frame f = renderFresh(scene, config, device);
+    const Frame f = renderFresh(scene, config, vulkan);
     const StageTimes& t = f.report.times;
     vox.push_back(t.voxelize);
     res.push_back(t.resample);
@@ -409,19 +387,15 @@ int runBenchError(const BenchErrorArgs& args) {
   info.block = args.block;
   info.repeats = args.repeats;
   std::vector<BenchConfig> configs = expandConfigs(axes);
-  std::unique_ptr<Device> device;
+  std::unique_ptr<Backends> vulkan;
   if (std::find(axes.backends.begin(), axes.backends.end(), "vulkan") != axes.backends.end()) {
     std::string why;
-#ifdef SSLPV_HAVE_VULKAN
     try {
-      device = std::make_unique<Device>();
-    } catch (const GpuError& e) {
+      vulkan = std::make_unique<Backends>(BackendKind::Vulkan);
+    } catch (const ResourceError& e) {
       why = e.what();
     }
-#else
-    why = "this sslpv was built without Vulkan";
-#endif
-    if (!device) {
+    if (!vulkan) {
       std::size_t skipped = 0;
       for (const BenchConfig& c : configs) skipped += c.backend == "vulkan";
       const std::string line = "skipped the " + std::to_string(skipped * scenes.size()) +
@@ -454,7 +428,7 @@ int runBenchError(const BenchErrorArgs& args) {
       std::fprintf(stderr, "bench-error: [%zu/%zu] %s %s %s grid %d steps %s shadow map %d%s\n", done + 1, total,
                    args.scenes[s].c_str(), config.backend.c_str(), lpvSchemeName(config.scheme).c_str(),
                    config.grid, config.stepsText().c_str(), config.shadowMap, eta.c_str());
-      rows.push_back(runConfig(args.scenes[s], scenes[s], config, references[s], args, device.get()));
+      rows.push_back(runConfig(args.scenes[s], scenes[s], config, references[s], args, vulkan.get()));
       std::fprintf(stderr, "bench-error:   %.1f ms (median of %d), %d steps, mean relative error %.4g\n",
                    rows.back().ms.total, args.repeats, rows.back().stepsRun, rows.back().metrics.meanRelativeError);
     }

@@ -26,13 +26,11 @@
 #include "apps/cmd_inspect.h"
 #include "apps/cmd_view.h"
 #include "apps/cli_output.h"
+#include "backend/backends.h"
 #ifdef SSLPV_HAVE_VULKAN
-#include "gpu/device.h"
 #include "gpu/vk_check.h"
-#include "gpu/vulkan_renderer.h"
 #endif
 #include "volume/atomic_file.h"
-#include "volume/cpu_renderer.h"
 #include "volume/error.h"
 #include "volume/image_io.h"
 #include "volume/input_ranges.h"
@@ -103,46 +101,10 @@ struct RenderArgs {
   float exposure = 1.0f;
 };
 
-/// One renderer of either backend, kept across the frames of a sequence so that each
-/// frame re-runs only what the new pose changes.
-class FrameRenderer {
- public:
-  virtual ~FrameRenderer() = default;
-  virtual void setTime(double t) = 0;
-  virtual sslpv::Image render(const sslpv::LpvSettings& settings, sslpv::RenderReport& report) = 0;
-};
-
-class CpuFrameRenderer : public FrameRenderer {
- public:
-  explicit CpuFrameRenderer(const sslpv::Scene& scene) : renderer_(scene) {}
-  void setTime(double t) override { renderer_.setTime(t); }
-  sslpv::Image render(const sslpv::LpvSettings& settings, sslpv::RenderReport& report) override {
-    return renderer_.render(settings, &report);
-  }
-
- private:
-  sslpv::CpuRenderer renderer_;
-};
-
-#ifdef SSLPV_HAVE_VULKAN
-class VulkanFrameRenderer : public FrameRenderer {
- public:
-  VulkanFrameRenderer(const sslpv::Scene& scene, const sslpv::gpu::VulkanDevice& device) : renderer_(scene, device) {}
-  void setTime(double t) override { renderer_.setTime(t); }
-  sslpv::Image render(const sslpv::LpvSettings& settings, sslpv::RenderReport& report) override {
-    return renderer_.render(settings, &report);
-  }
-
- private:
-  sslpv::gpu::VulkanRenderer renderer_;
-};
-#endif
-
 int runRender(const RenderArgs& args) {
   using namespace sslpv;
   const auto start = CliClock::now();
-  if (args.backend != "cpu" && args.backend != "vulkan" && args.backend != "auto")
-    throw InputError("--backend: unknown backend '" + args.backend + "' (auto, vulkan, cpu)");
+  const BackendKind backendKind = parseBackendKind(args.backend);
   if (!isSupportedImageExtension(args.output))
     throw InputError(args.output + ": unsupported output format (use .png, .pfm or .exr)");
   // Checked before the render: a bad flag should not cost one.
@@ -177,44 +139,15 @@ int runRender(const RenderArgs& args) {
   if (scene.deformers.empty() && (args.time || frames.size() > 1))
     printWarning(args.scene + ": the scene has no \"deformers\": every time renders the same image");
 
-  std::string autoNote;
-#ifdef SSLPV_HAVE_VULKAN
-  // Declared before the renderer, so that it outlives it.
-  std::unique_ptr<gpu::VulkanDevice> device;
-#endif
-  std::unique_ptr<FrameRenderer> renderer;
+  // One renderer kept across the frames of a sequence, so that each frame re-runs only
+  // what the new pose changes.
+  Backends backends(backendKind);
   // The first Vulkan frame compiles the device's pipelines unless Mesa's shader cache has
   // them (4 s on lavapipe with an empty cache): a terminal sees the wait, not silence.
   std::optional<WaitNotice> firstFrame;
-#ifdef SSLPV_HAVE_VULKAN
-  if (args.backend != "cpu") {
-    try {
-      device = std::make_unique<gpu::VulkanDevice>();
-    } catch (const GpuError& e) {
-      // NoVulkanDeviceError included: the machine lacks what the GPU backend needs.
-      if (args.backend == "vulkan")
-        throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
-      autoNote = std::string("--backend auto: no usable Vulkan device (") + e.what() + "); the CPU backend rendered";
-    }
-    if (device && args.backend == "auto" && device->runsOnCpu()) {
-      autoNote = "--backend auto: " + device->name() +
-                 " is Vulkan on the CPU; the CPU backend is faster here (--backend vulkan to use it)";
-      device.reset();
-    }
-  }
-  if (device) {
-    firstFrame.emplace("render: preparing the Vulkan pipelines");
-    try {
-      renderer = std::make_unique<VulkanFrameRenderer>(scene, *device);
-    } catch (const GpuError& e) {
-      throw ResourceError(std::string("--backend vulkan: ") + e.what() + " (--backend cpu needs no GPU)");
-    }
-  }
-#else
-  if (args.backend == "vulkan")
-    throw ResourceError("--backend vulkan: this sslpv was built without Vulkan (--backend cpu needs no GPU)");
-#endif
-  if (!renderer) renderer = std::make_unique<CpuFrameRenderer>(scene);
+  if (backends.usesVulkan()) firstFrame.emplace("render: preparing the Vulkan pipelines");
+  std::unique_ptr<Renderer> renderer = backends.make(scene);
+  const std::string autoNote = backends.note();
   if (!scene.deformers.empty() && frames.size() > 1) {
     // Every pose is checked before the first file is written: a fold at frame 40 must
     // not leave 39 frames behind. The renderer has checked the mesh itself.
@@ -232,7 +165,7 @@ int runRender(const RenderArgs& args) {
     try {
 #endif
       if (i > 0) renderer->setTime(frames[i].first);
-      image = renderer->render(settings, report);
+      image = renderer->render(settings, &report);
       firstFrame.reset();
 #ifdef SSLPV_HAVE_VULKAN
     } catch (const GpuError& e) {

@@ -19,10 +19,9 @@
 #include "apps/view_controls.h"
 #include "apps/view_overlay.h"
 #include "apps/view_worker.h"
+#include "backend/backends.h"
 #include "gpu/device.h"
 #include "gpu/presenter.h"
-#include "gpu/vulkan_renderer.h"
-#include "volume/cpu_renderer.h"
 #include "volume/error.h"
 #include "volume/image_io.h"
 
@@ -64,40 +63,16 @@ struct WindowDeleter {
   void operator()(GLFWwindow* window) const { glfwDestroyWindow(window); }
 };
 
-/// Adapts a backend to the render thread's interface.
-template <typename Renderer>
-class Backend final : public FrameRenderer {
- public:
-  template <typename... Args>
-  explicit Backend(Args&&... args) : renderer_(std::forward<Args>(args)...) {}
-  void setCamera(const Camera& camera) override { renderer_.setCamera(camera); }
-  void setLights(const std::vector<Light>& lights) override { renderer_.setLights(lights); }
-  void setTime(double t) override { renderer_.setTime(t); }
-  Image render(const LpvSettings& settings, RenderReport* report) override {
-    return renderer_.render(settings, report);
-  }
-
- private:
-  Renderer renderer_;
-};
-
-/// Made on the render thread. "auto" takes the Vulkan backend on a real GPU only: on a
-/// CPU device (lavapipe) the CPU backend is the faster one. It tries Vulkan once and
-/// stays on the CPU backend after it fails (a device without float atomics, say).
+/// Made on the render thread: the backend the user chose (backend/backends.h), rendering
+/// on the window's device. Under auto, a Vulkan backend that cannot run here is tried
+/// once; the CPU backend renders from then on.
 RendererFactory makeFactory(const std::string& backend, const gpu::VulkanDevice& device) {
-  auto vulkanFailed =
-      std::make_shared<bool>(backend == "auto" && device.runsOnCpu());
-  return [backend, &device, vulkanFailed](const Scene& scene) -> std::unique_ptr<FrameRenderer> {
-    if (backend == "cpu" || (backend == "auto" && *vulkanFailed))
-      return std::make_unique<Backend<CpuRenderer>>(scene);
-    try {
-      return std::make_unique<Backend<gpu::VulkanRenderer>>(scene, device);
-    } catch (const GpuError& e) {
-      if (backend == "vulkan") throw ResourceError(std::string("--backend vulkan: ") + e.what());
-      *vulkanFailed = true;
-      printWarning(std::string("view: the Vulkan backend cannot run here (") + e.what() + "); using the CPU backend");
-      return std::make_unique<Backend<CpuRenderer>>(scene);
-    }
+  auto backends = std::make_shared<Backends>(parseBackendKind(backend), device);
+  return [backends](const Scene& scene) -> std::unique_ptr<Renderer> {
+    const bool wasVulkan = backends->usesVulkan();
+    std::unique_ptr<Renderer> renderer = backends->make(scene);
+    if (wasVulkan && !backends->usesVulkan()) printWarning("view: " + backends->note());
+    return renderer;
   };
 }
 

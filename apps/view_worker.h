@@ -15,25 +15,13 @@
 
 #include "volume/frame_report.h"
 #include "volume/image_io.h"
+#include "volume/renderer.h"
 #include "volume/scene.h"
 
 namespace sslpv {
 
-/// What the viewer needs of a backend (CpuRenderer and gpu::VulkanRenderer alike): both
-/// cache per stage, so a camera-only change re-shades and a light change re-propagates.
-class FrameRenderer {
- public:
-  virtual ~FrameRenderer() = default;
-  virtual void setCamera(const Camera& camera) = 0;
-  virtual void setLights(const std::vector<Light>& lights) = 0;
-  /// Poses a deforming scene at time t, keeping the backend and its grid (a no-op for a
-  /// static scene). InputError when the pose folds the mesh.
-  virtual void setTime(double t) = 0;
-  virtual Image render(const LpvSettings& settings, RenderReport* report) = 0;
-};
-
 /// Builds a backend for a scene; throws (InputError, GpuError, ...) when it cannot.
-using RendererFactory = std::function<std::unique_ptr<FrameRenderer>(const Scene&)>;
+using RendererFactory = std::function<std::unique_ptr<Renderer>(const Scene&)>;
 
 struct RenderRequest {
   /// A new pointer (a reload) builds a new backend; the same one reuses the cached stages.
@@ -87,7 +75,7 @@ class RenderWorker {
   bool stop_ = false;
 
   // Owned by the render thread.
-  std::unique_ptr<FrameRenderer> renderer_;
+  std::unique_ptr<Renderer> renderer_;
   std::shared_ptr<const Scene> rendererScene_, failedScene_;
   std::optional<Camera> camera_;
   std::optional<std::vector<Light>> lights_;

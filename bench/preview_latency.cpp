@@ -78,7 +78,7 @@ double medianOf(const std::vector<Run>& runs, F field) {
   return median(v);
 }
 
-Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, bool autoSteps, int size, int warmup,
+Row measure(const fs::path& scenePath, BackendKind backend, int grid, bool autoSteps, int size, int warmup,
             int runs) {
   const Scene scene = loadScene(scenePath);
   PreviewOptions options;
@@ -115,7 +115,7 @@ Row measure(const fs::path& scenePath, PreviewBackendKind backend, int grid, boo
   Scene fullScene = scene;
   fullScene.camera = session.previewCamera();
   fullScene.material.vdb.reset();
-  std::unique_ptr<PreviewRenderer> full = makePreviewRenderer(fullScene, backend);
+  std::unique_ptr<Renderer> full = makeRenderer(fullScene, backend);
   full->setMaterialSet(session.engine().materialSet(), std::nullopt);
   full->render(session.previewSettings(), nullptr);
   std::vector<double> fullMs, fullResample, fullPropagation, fullSteps;
@@ -274,28 +274,28 @@ int main(int argc, char** argv) {
               "resamp", "propag", "shade", "other", "total", "full", "resamp", "propag", "steps", "cold", "inc/f", "tot/f",
               "maxdiff", "ui", "shown", "draft");
 
-  std::vector<PreviewBackendKind> kinds;
-  if (backends != "vulkan") kinds.push_back(PreviewBackendKind::Cpu);
-  if (backends != "cpu") kinds.push_back(PreviewBackendKind::Vulkan);
+  std::vector<BackendKind> kinds;
+  if (backends != "vulkan") kinds.push_back(BackendKind::Cpu);
+  if (backends != "cpu") kinds.push_back(BackendKind::Vulkan);
   bool vulkanMissing = false;
   for (const char* name : {"marble_pebble.json", "jade_slab_backlit.json"})
-    for (PreviewBackendKind kind : kinds)
+    for (BackendKind kind : kinds)
       for (int grid : {32, 64})
         for (bool autoSteps : {true, false}) {
-          if (kind == PreviewBackendKind::Vulkan && vulkanMissing) continue;
+          if (kind == BackendKind::Vulkan && vulkanMissing) continue;
           if (grids != "both" && std::to_string(grid) != grids) continue;
           try {
             printRow(measure(examples / name, kind, grid, autoSteps, size, warmup, runs));
             std::fflush(stdout);
 #ifdef PREVIEW_BENCH_GPU_ERROR
           } catch (const GpuError& e) {
-            if (kind != PreviewBackendKind::Vulkan) throw;
+            if (kind != BackendKind::Vulkan) throw;
             vulkanMissing = true;
             std::printf("SKIPPED vulkan rows: %s\n", e.what());
 #endif
           } catch (const ResourceError& e) {
             // Built without the Vulkan backend.
-            if (kind != PreviewBackendKind::Vulkan) throw;
+            if (kind != BackendKind::Vulkan) throw;
             vulkanMissing = true;
             std::printf("SKIPPED vulkan rows: %s\n", e.what());
           } catch (const InputError& e) {

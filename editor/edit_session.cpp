@@ -289,14 +289,14 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
   previewScene.camera = m.camera;
   previewScene.material.vdb.reset();
   const PreviewRendererFactory make =
-      preview.makeRenderer ? preview.makeRenderer : PreviewRendererFactory(makePreviewRenderer);
-  std::unique_ptr<PreviewRenderer> renderer = make(previewScene, preview.backend);
+      preview.makeRenderer ? preview.makeRenderer : PreviewRendererFactory(makeRenderer);
+  std::unique_ptr<Renderer> renderer = make(previewScene, preview.backend);
   m.backendName = renderer->name();
   // Drafts render on the CPU whatever the backend: a 16³ frame takes milliseconds there,
   // less than creating a second Vulkan device would. Both renderers exist before either
   // worker thread starts (the mesh reader forks).
-  std::unique_ptr<PreviewRenderer> draftRenderer;
-  if (settings.resolution > kDraftPreviewResolution) draftRenderer = make(previewScene, PreviewBackendKind::Cpu);
+  std::unique_ptr<Renderer> draftRenderer;
+  if (settings.resolution > kDraftPreviewResolution) draftRenderer = make(previewScene, BackendKind::Cpu);
   m.full.settings = settings;
   m.full.worker = std::make_unique<PreviewWorker>(std::move(renderer));
   if (draftRenderer) {

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "backend/backends.h"
 #include "editor/brush_engine.h"
 #include "volume/frame_report.h"
 #include "volume/error.h"
@@ -39,37 +40,19 @@
 
 namespace sslpv {
 
-enum class PreviewBackendKind { Cpu, Vulkan };
-
-/// The renderers' common face (CpuRenderer, VulkanRenderer), so the preview does not care.
-class PreviewRenderer {
- public:
-  virtual ~PreviewRenderer() = default;
-  virtual Image render(const LpvSettings& settings, RenderReport* report) = 0;
-  virtual void setCamera(const Camera& camera) = 0;
-  virtual void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) = 0;
-  /// "cpu" or "vulkan (<device name>)".
-  virtual std::string name() const = 0;
-};
-
-/// The preview renderer for `scene` (whose camera sets the preview's size). Vulkan creates
-/// its own device; throws GpuError (gpu/vk_check.h) when there is none, InputError on a
-/// bad scene.
-std::unique_ptr<PreviewRenderer> makePreviewRenderer(const Scene& scene, PreviewBackendKind backend);
-
 /// Builds a preview renderer. Tests put a deliberately slow or counting renderer here.
-using PreviewRendererFactory = std::function<std::unique_ptr<PreviewRenderer>(const Scene&, PreviewBackendKind)>;
+using PreviewRendererFactory = std::function<std::unique_ptr<Renderer>(const Scene&, BackendKind)>;
 
 /// The grid of the draft frames shown during a stroke (PreviewQuality::Draft).
 constexpr int kDraftPreviewResolution = 16;
 
 struct PreviewOptions {
-  PreviewBackendKind backend = PreviewBackendKind::Cpu;
+  BackendKind backend = BackendKind::Cpu;
   /// Longest side of the preview image in pixels; the scene camera's aspect is kept.
   int longestSide = 256;
   /// LPV settings of the preview; absent: the scene's lpv settings.
   std::optional<LpvSettings> lpv;
-  /// Absent: makePreviewRenderer.
+  /// Absent: makeRenderer (backend/backends.h), a Vulkan preview on a device of its own.
   PreviewRendererFactory makeRenderer;
 };
 

@@ -5,7 +5,7 @@
 
 namespace sslpv {
 
-PreviewWorker::PreviewWorker(std::unique_ptr<PreviewRenderer> renderer)
+PreviewWorker::PreviewWorker(std::unique_ptr<Renderer> renderer)
     : renderer_(std::move(renderer)), thread_([this] { run(); }) {}
 
 PreviewWorker::~PreviewWorker() {

@@ -33,7 +33,7 @@ struct PreviewJob {
 
 class PreviewWorker {
  public:
-  explicit PreviewWorker(std::unique_ptr<PreviewRenderer> renderer);
+  explicit PreviewWorker(std::unique_ptr<Renderer> renderer);
   /// Lets a render in progress finish, drops a pending job.
   ~PreviewWorker();
   PreviewWorker(const PreviewWorker&) = delete;
@@ -64,7 +64,7 @@ class PreviewWorker {
   std::uint64_t rendered_ = 0;
 
   // Worker thread only.
-  std::unique_ptr<PreviewRenderer> renderer_;
+  std::unique_ptr<Renderer> renderer_;
   /// The newest set and camera jobs carried: after a frame failed half way, the renderer
   /// gets them whole.
   std::shared_ptr<const MaterialSet> lastSet_;

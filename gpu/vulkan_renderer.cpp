@@ -47,6 +47,8 @@ VulkanRenderer::VulkanRenderer(const Scene& scene, const VulkanDevice& device)
 
 VulkanRenderer::~VulkanRenderer() = default;
 
+std::string VulkanRenderer::name() const { return "vulkan (" + device_.name() + ")"; }
+
 void VulkanRenderer::setCamera(const Camera& camera) {
   scene_.camera = camera;
   dirty_.cameraChanged();

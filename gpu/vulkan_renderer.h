@@ -5,12 +5,14 @@
 // Resampling the painted material set stays on the CPU (OpenVDB) and is uploaded.
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "gpu/device.h"
 #include "volume/frame_report.h"
 #include "volume/image_io.h"
 #include "volume/lpv_stages.h"
+#include "volume/renderer.h"
 #include "volume/scene.h"
 #include "volume/scene_object.h"
 
@@ -24,27 +26,29 @@ class GpuPropagator;
 class GpuShader;
 class Buffer;
 
-class VulkanRenderer {
+class VulkanRenderer final : public Renderer {
  public:
   /// Loads the object as the CPU backend does (InputError on bad input) and uploads the
   /// mesh to `device`, which must outlive the renderer.
   VulkanRenderer(const Scene& scene, const VulkanDevice& device);
-  ~VulkanRenderer();
+  ~VulkanRenderer() override;
   VulkanRenderer(const VulkanRenderer&) = delete;
   VulkanRenderer& operator=(const VulkanRenderer&) = delete;
 
   /// Renders one frame with the given LPV settings, re-running only what changed.
   /// Stage times in the report are GPU times from timestamps (wall-clock for the CPU
   /// resampling and where the device has no timestamps).
-  Image render(const LpvSettings& settings, RenderReport* report = nullptr);
+  Image render(const LpvSettings& settings, RenderReport* report = nullptr) override;
 
-  void setCamera(const Camera& camera);
-  void setLights(const std::vector<Light>& lights);
-  void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched);
+  void setCamera(const Camera& camera) override;
+  void setLights(const std::vector<Light>& lights) override;
+  void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) override;
   /// Poses a deforming scene at time `t` (as CpuRenderer::setTime): new vertex positions
   /// on the device, then voxelization onwards. Each frame propagates cold, as every
   /// frame of this backend does.
-  void setTime(double t);
+  void setTime(double t) override;
+  /// "vulkan (<device name>)".
+  std::string name() const override;
 
   const Scene& scene() const { return scene_; }
   /// Per pixel of the last shaded frame, the 1-based index of the triangle seen there

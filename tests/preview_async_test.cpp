@@ -65,22 +65,24 @@ class Gate {
 };
 
 /// The real CPU preview, each render held by the gate first.
-class GatedRenderer final : public PreviewRenderer {
+class GatedRenderer final : public Renderer {
  public:
-  GatedRenderer(std::unique_ptr<PreviewRenderer> inner, std::shared_ptr<Gate> gate)
+  GatedRenderer(std::unique_ptr<Renderer> inner, std::shared_ptr<Gate> gate)
       : inner_(std::move(inner)), gate_(std::move(gate)) {}
   Image render(const LpvSettings& settings, RenderReport* report) override {
     gate_->pass();
     return inner_->render(settings, report);
   }
   void setCamera(const Camera& camera) override { inner_->setCamera(camera); }
+  void setLights(const std::vector<Light>& lights) override { inner_->setLights(lights); }
   void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) override {
     inner_->setMaterialSet(std::move(set), touched);
   }
+  void setTime(double t) override { inner_->setTime(t); }
   std::string name() const override { return inner_->name(); }
 
  private:
-  std::unique_ptr<PreviewRenderer> inner_;
+  std::unique_ptr<Renderer> inner_;
   std::shared_ptr<Gate> gate_;
 };
 
@@ -89,11 +91,11 @@ class GatedRenderer final : public PreviewRenderer {
 PreviewOptions gatedPreview(std::shared_ptr<Gate> gate, int which = -1) {
   PreviewOptions options = smallPreview();
   auto built = std::make_shared<int>(0);
-  options.makeRenderer = [gate, which, built](const Scene& scene, PreviewBackendKind backend) {
-    std::unique_ptr<PreviewRenderer> inner = makePreviewRenderer(scene, backend);
+  options.makeRenderer = [gate, which, built](const Scene& scene, BackendKind backend) {
+    std::unique_ptr<Renderer> inner = makeRenderer(scene, backend);
     const int index = (*built)++;
     if (which >= 0 && index != which) return inner;
-    return std::unique_ptr<PreviewRenderer>(std::make_unique<GatedRenderer>(std::move(inner), gate));
+    return std::unique_ptr<Renderer>(std::make_unique<GatedRenderer>(std::move(inner), gate));
   };
   return options;
 }
@@ -246,27 +248,29 @@ TEST(PreviewAsync, AFailedFrameReportsItsReasonAndTheNextFrameIsWhole) {
   // and the following frame, rebuilt from the whole newest state, equals a fresh render.
   Files f;
   auto failNext = std::make_shared<bool>(false);
-  class Failing final : public PreviewRenderer {
+  class Failing final : public Renderer {
    public:
-    Failing(std::unique_ptr<PreviewRenderer> inner, std::shared_ptr<bool> fail)
+    Failing(std::unique_ptr<Renderer> inner, std::shared_ptr<bool> fail)
         : inner_(std::move(inner)), fail_(std::move(fail)) {}
     Image render(const LpvSettings& settings, RenderReport* report) override {
       if (std::exchange(*fail_, false)) throw ResourceError("test: the preview ran out of memory");
       return inner_->render(settings, report);
     }
     void setCamera(const Camera& camera) override { inner_->setCamera(camera); }
+    void setLights(const std::vector<Light>& lights) override { inner_->setLights(lights); }
     void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) override {
       inner_->setMaterialSet(std::move(set), touched);
     }
+    void setTime(double t) override { inner_->setTime(t); }
     std::string name() const override { return inner_->name(); }
 
    private:
-    std::unique_ptr<PreviewRenderer> inner_;
+    std::unique_ptr<Renderer> inner_;
     std::shared_ptr<bool> fail_;
   };
   PreviewOptions options = smallPreview();
-  options.makeRenderer = [failNext](const Scene& scene, PreviewBackendKind backend) {
-    return std::unique_ptr<PreviewRenderer>(std::make_unique<Failing>(makePreviewRenderer(scene, backend), failNext));
+  options.makeRenderer = [failNext](const Scene& scene, BackendKind backend) {
+    return std::unique_ptr<Renderer>(std::make_unique<Failing>(makeRenderer(scene, backend), failNext));
   };
   EditSession s(f.scene, options);
   s.renderPreview();

@@ -4,12 +4,14 @@
 // changed (a camera move re-shades, a brush stroke re-resamples its region).
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "volume/coarse_start.h"
 #include "volume/frame_report.h"
 #include "volume/image_io.h"
 #include "volume/lpv_stages.h"
+#include "volume/renderer.h"
 #include "volume/scene.h"
 #include "volume/scene_object.h"
 #include "volume/single_scattering.h"
@@ -20,26 +22,26 @@ struct ShadingSurface;
 
 class RayScene;
 
-class CpuRenderer {
+class CpuRenderer final : public Renderer {
  public:
   /// Loads and checks the mesh (closed), builds the ray-casting structure and loads the
   /// material set. Throws InputError on bad input.
   explicit CpuRenderer(const Scene& scene);
-  ~CpuRenderer();
+  ~CpuRenderer() override;
   CpuRenderer(const CpuRenderer&) = delete;
   CpuRenderer& operator=(const CpuRenderer&) = delete;
 
   /// Renders one frame with the given LPV settings (they override the scene's),
   /// re-running only what changed since the previous frame.
-  Image render(const LpvSettings& settings, RenderReport* report = nullptr);
+  Image render(const LpvSettings& settings, RenderReport* report = nullptr) override;
 
   /// The next frame re-shades only. `camera` must be valid (as the scene loader checks).
-  void setCamera(const Camera& camera);
+  void setCamera(const Camera& camera) override;
   /// The next frame re-runs shadow maps onwards.
-  void setLights(const std::vector<Light>& lights);
+  void setLights(const std::vector<Light>& lights) override;
   /// A painted material set: the next frame re-resamples the cells overlapping
   /// `touched` (world bounds; everything when absent) and re-propagates.
-  void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched);
+  void setMaterialSet(std::shared_ptr<const MaterialSet> set, const std::optional<Bounds>& touched) override;
 
   /// Poses a deforming scene (Scene::deformers) at time `t`: the next frame re-voxelizes,
   /// re-resamples through the new inverse and re-runs everything after. The last frame's
@@ -47,7 +49,8 @@ class CpuRenderer {
   /// bounds decide the frame, so a bending object mostly gets a new one and a coarse
   /// start instead). InputError, renderer unchanged, when the pose folds the mesh; no-op
   /// without deformers.
-  void setTime(double t);
+  void setTime(double t) override;
+  std::string name() const override { return "cpu"; }
 
   /// The next propagation starts cold, as the first frame's does, instead of from the
   /// last frame's converged light (benchmarks of whole frames, comparisons).

@@ -111,7 +111,7 @@ int run(const Options& options) {
   const std::string playScript = options.play.empty() ? std::string() : readText(options.play);
 
   PreviewOptions preview;
-  preview.backend = options.backend == "vulkan" ? PreviewBackendKind::Vulkan : PreviewBackendKind::Cpu;
+  preview.backend = options.backend == "vulkan" ? BackendKind::Vulkan : BackendKind::Cpu;
   preview.longestSide = options.previewSize;
   std::unique_ptr<EditSession> session;
   std::string fallbackNote;
@@ -125,10 +125,10 @@ int run(const Options& options) {
     } catch (const std::exception& e) {
       // No usable Vulkan device: the preview runs on the CPU backend (same interface,
       // same image within 0.2 %) unless the user asked for Vulkan by name.
-      if (preview.backend != PreviewBackendKind::Vulkan || options.backendGiven) throw;
+      if (preview.backend != BackendKind::Vulkan || options.backendGiven) throw;
       fallbackNote = std::string("Vulkan preview unavailable (") + e.what() + "): previewing on the CPU";
       std::fprintf(stderr, "sslpv edit: %s\n", fallbackNote.c_str());
-      preview.backend = PreviewBackendKind::Cpu;
+      preview.backend = BackendKind::Cpu;
       session = std::make_unique<EditSession>(options.scene, preview);
     }
   } catch (const InputError& e) {
