@@ -46,7 +46,7 @@ class Backends {
 
  private:
   struct Device;
-  BackendKind kind_;
+  [[maybe_unused]] BackendKind kind_;  // read only where Vulkan is built
   std::shared_ptr<Device> device_;
   bool usesVulkan_ = false;
   std::string note_;
