@@ -7,7 +7,7 @@
 #include <iostream>
 #include <utility>
 
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 namespace sslpv {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <thread>
 
-#include "volume/image_io.h"
-#include "volume/scene.h"
+#include "volume/core/image_io.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 

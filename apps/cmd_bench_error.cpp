@@ -24,13 +24,13 @@
 
 #include "apps/cli_output.h"
 #include "backend/backends.h"
-#include "volume/atomic_file.h"
-#include "volume/bench_table.h"
-#include "volume/error.h"
-#include "volume/image_io.h"
-#include "volume/image_metrics.h"
-#include "volume/reference_tracer.h"
-#include "volume/scene.h"
+#include "volume/core/atomic_file.h"
+#include "volume/eval/bench_table.h"
+#include "volume/core/error.h"
+#include "volume/core/image_io.h"
+#include "volume/eval/image_metrics.h"
+#include "volume/reference/reference_tracer.h"
+#include "volume/scene/scene.h"
 
 extern char** environ;
 

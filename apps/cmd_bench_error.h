@@ -1,7 +1,7 @@
 #pragma once
 // `sslpv bench-error SCENES... -o PREFIX`: run time against error. Renders every
 // configuration (cross product of the comma lists) of every scene, compares each with a
-// cached path-traced reference (volume/image_metrics.h) and writes PREFIX.csv,
+// cached path-traced reference (volume/eval/image_metrics.h) and writes PREFIX.csv,
 // PREFIX.json and PREFIX.png (error against time, Pareto fronts marked; drawn by the
 // separate sslpv-plot program so the sslpv binary never links VTK).
 #include <CLI/CLI.hpp>

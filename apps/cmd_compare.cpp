@@ -10,10 +10,10 @@
 #include <string>
 
 #include "apps/cli_output.h"
-#include "volume/atomic_file.h"
-#include "volume/error.h"
-#include "volume/image_io.h"
-#include "volume/image_metrics.h"
+#include "volume/core/atomic_file.h"
+#include "volume/core/error.h"
+#include "volume/core/image_io.h"
+#include "volume/eval/image_metrics.h"
 
 namespace sslpv {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 // `sslpv compare A B`: error metrics of a test image A (an SSLPV render) against a
 // reference B (usually `sslpv reference`), over the object's pixels. Definitions of the
-// metrics in volume/image_metrics.h.
+// metrics in volume/eval/image_metrics.h.
 #include <CLI/CLI.hpp>
 #include <string>
 

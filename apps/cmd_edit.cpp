@@ -6,7 +6,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 namespace sslpv {
 

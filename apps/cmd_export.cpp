@@ -5,10 +5,10 @@
 #include <iostream>
 
 #include "apps/cli_output.h"
-#include "volume/atomic_file.h"
-#include "volume/error.h"
-#include "volume/pbrt_export.h"
-#include "volume/scene.h"
+#include "volume/core/atomic_file.h"
+#include "volume/core/error.h"
+#include "volume/eval/pbrt_export.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 

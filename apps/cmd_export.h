@@ -1,6 +1,6 @@
 #pragma once
 // `sslpv export SCENE.json --pbrt OUT.pbrt [--grid N]`: the scene for another renderer.
-// pbrt-v4 for now (volume/pbrt_export.h), so sslpv can be checked independently.
+// pbrt-v4 for now (volume/eval/pbrt_export.h), so sslpv can be checked independently.
 #include <CLI/CLI.hpp>
 
 #include <optional>

@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "volume/material_set.h"
+#include "volume/material/material_set.h"
 
 namespace sslpv {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 // `sslpv inspect`'s summary of a valid material set in the quantities an artist reads
 // (albedo, mean free path, g) rather than the stored σt and σs. The grid listing and
-// validation come from inspectVdbFile (volume/material_set.h).
+// validation come from inspectVdbFile (volume/material/material_set.h).
 #include <filesystem>
 #include <ostream>
 

@@ -13,13 +13,13 @@
 #include "apps/cli_output.h"
 #include "editor/brush_engine.h"
 #include "editor/stroke_io.h"
-#include "volume/atomic_file.h"
-#include "volume/error.h"
-#include "volume/material_set.h"
-#include "volume/scene.h"
-#include "volume/scene_checks.h"
-#include "volume/scene_file_edit.h"
-#include "volume/strict_json.h"
+#include "volume/core/atomic_file.h"
+#include "volume/core/error.h"
+#include "volume/material/material_set.h"
+#include "volume/scene/scene.h"
+#include "volume/scene/scene_checks.h"
+#include "volume/scene/scene_file_edit.h"
+#include "volume/core/strict_json.h"
 
 namespace sslpv {
 namespace {

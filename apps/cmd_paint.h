@@ -3,7 +3,7 @@
 // [--g G]]`: applies a stroke file (format in editor/stroke_io.h) to the scene's material
 // set (or to empty grids when the scene has none) with the brush engine the editor uses,
 // and writes the painted set atomically. The flags give the material, as surface colour
-// and scatter distance (volume/artist_params.h), of strokes that name none, so one file of
+// and scatter distance (volume/material/artist_params.h), of strokes that name none, so one file of
 // paths can be painted in any colour.
 #include <CLI/CLI.hpp>
 #include <string>

@@ -3,7 +3,7 @@
 #include <cctype>
 #include <cstdio>
 
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 namespace sslpv {
 namespace {

@@ -3,12 +3,12 @@
 #include <filesystem>
 
 #include "apps/cli_output.h"
-#include "volume/atomic_file.h"
-#include "volume/error.h"
-#include "volume/image_io.h"
-#include "volume/input_ranges.h"
-#include "volume/scene.h"
-#include "volume/strict_json.h"
+#include "volume/core/atomic_file.h"
+#include "volume/core/error.h"
+#include "volume/core/image_io.h"
+#include "volume/core/input_ranges.h"
+#include "volume/scene/scene.h"
+#include "volume/core/strict_json.h"
 #ifdef SSLPV_HAVE_VIEWER
 #include "apps/view_script.h"
 #include "apps/view_window.h"

@@ -28,18 +28,18 @@
 #include "apps/cli_output.h"
 #include "backend/backends.h"
 #ifdef SSLPV_HAVE_VULKAN
-#include "gpu/vk_check.h"
+#include "gpu/vk/vk_check.h"
 #endif
-#include "volume/atomic_file.h"
-#include "volume/error.h"
-#include "volume/image_io.h"
-#include "volume/input_ranges.h"
-#include "volume/material_set.h"
-#include "volume/mesh.h"
-#include "volume/reference_tracer.h"
-#include "volume/scene.h"
-#include "volume/scene_checks.h"
-#include "volume/strict_json.h"
+#include "volume/core/atomic_file.h"
+#include "volume/core/error.h"
+#include "volume/core/image_io.h"
+#include "volume/core/input_ranges.h"
+#include "volume/material/material_set.h"
+#include "volume/scene/mesh.h"
+#include "volume/reference/reference_tracer.h"
+#include "volume/scene/scene.h"
+#include "volume/scene/scene_checks.h"
+#include "volume/core/strict_json.h"
 
 namespace {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
-#include "volume/math_constants.h"
+#include "volume/core/math_constants.h"
 
 namespace sslpv {
 

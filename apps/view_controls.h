@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "volume/scene.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 

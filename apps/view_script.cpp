@@ -6,7 +6,7 @@
 #include <sstream>
 #include <utility>
 
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 namespace sslpv {
 

@@ -20,10 +20,10 @@
 #include "apps/view_overlay.h"
 #include "apps/view_worker.h"
 #include "backend/backends.h"
-#include "gpu/device.h"
-#include "gpu/presenter.h"
-#include "volume/error.h"
-#include "volume/image_io.h"
+#include "gpu/vk/device.h"
+#include "gpu/vk/presenter.h"
+#include "volume/core/error.h"
+#include "volume/core/image_io.h"
 
 namespace sslpv {
 

@@ -1,11 +1,11 @@
 #pragma once
 // The window of `sslpv view`: GLFW for the window and input, a Vulkan swapchain
-// (gpu/presenter.h) for presentation, a render thread (apps/view_worker.h) for frames.
+// (gpu/vk/presenter.h) for presentation, a render thread (apps/view_worker.h) for frames.
 #include <vector>
 
 #include "apps/cmd_view.h"
 #include "apps/view_script.h"
-#include "volume/scene.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 

@@ -3,7 +3,7 @@
 #include <new>
 #include <utility>
 
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 namespace sslpv {
 

@@ -13,10 +13,10 @@
 #include <thread>
 #include <vector>
 
-#include "volume/frame_report.h"
-#include "volume/image_io.h"
-#include "volume/renderer.h"
-#include "volume/scene.h"
+#include "volume/lpv/frame_report.h"
+#include "volume/core/image_io.h"
+#include "volume/lpv/renderer.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 

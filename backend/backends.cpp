@@ -2,16 +2,16 @@
 
 #include <utility>
 
-#include "volume/cpu_renderer.h"
-#include "volume/error.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/core/error.h"
 
 #ifdef SSLPV_HAVE_VULKAN
-#include "gpu/device.h"
-#include "gpu/vk_check.h"
+#include "gpu/vk/device.h"
+#include "gpu/vk/vk_check.h"
 #include "gpu/vulkan_renderer.h"
 #elif __has_include(<vulkan/vulkan.h>)
 // GpuError is header-only: the promised exception type even without the GPU backend.
-#include "gpu/vk_check.h"
+#include "gpu/vk/vk_check.h"
 #define SSLPV_HAVE_GPU_ERROR
 #endif
 

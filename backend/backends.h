@@ -6,8 +6,8 @@
 #include <memory>
 #include <string>
 
-#include "volume/renderer.h"
-#include "volume/scene.h"
+#include "volume/lpv/renderer.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 
@@ -54,7 +54,7 @@ class Backends {
 
 /// A renderer for `scene` on `kind`, on a Vulkan device of its own: the editor's previews,
 /// one per open scene. Vulkan unavailable: NoVulkanDeviceError or another GpuError
-/// (gpu/vk_check.h), so a caller can fall back; auto falls back by itself.
+/// (gpu/vk/vk_check.h), so a caller can fall back; auto falls back by itself.
 std::unique_ptr<Renderer> makeRenderer(const Scene& scene, BackendKind kind);
 
 }  // namespace sslpv

@@ -1,4 +1,4 @@
-// Grid-layer bands, measured: the band amplitude of volume/image_metrics.h
+// Grid-layer bands, measured: the band amplitude of volume/eval/image_metrics.h
 // (gridBandAmplitude) on SSLPV renders of a homogeneous box turned by small angles
 // against the grid, a sphere, and any scene files given, at each grid, with the render's
 // time; and on a path-traced reference of each scene (no grid), which gives the metric's
@@ -19,11 +19,11 @@
 #include <vector>
 
 #include "bench/band_scenes.h"
-#include "volume/cpu_renderer.h"
-#include "volume/grid_band_samples.h"
-#include "volume/image_io.h"
-#include "volume/image_metrics.h"
-#include "volume/reference_tracer.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/eval/grid_band_samples.h"
+#include "volume/core/image_io.h"
+#include "volume/eval/image_metrics.h"
+#include "volume/reference/reference_tracer.h"
 
 namespace {
 using namespace sslpv;

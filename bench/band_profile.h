@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "bench/slab_scene.h"
-#include "volume/cpu_renderer.h"
-#include "volume/image_io.h"
-#include "volume/reference_tracer.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/core/image_io.h"
+#include "volume/reference/reference_tracer.h"
 
 namespace sslpv::bench {
 

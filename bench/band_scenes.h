@@ -1,12 +1,12 @@
 #pragma once
 // The scenes the grid-layer band metric is measured on (bench/band_metric and
-// tests/band_test.cpp): a 10 mm box or a 12 mm sphere of one measured material under a
+// tests/eval/band_test.cpp): a 10 mm box or a 12 mm sphere of one measured material under a
 // point light, seen from above and to the side so that three faces of the box show.
 #include <glm/vec3.hpp>
 
 #include "bench/slab_scene.h"
-#include "volume/material.h"
-#include "volume/scene.h"
+#include "volume/scene/material.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv::bench {
 

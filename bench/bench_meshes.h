@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <glm/vec3.hpp>
 
-#include "volume/mesh.h"
+#include "volume/scene/mesh.h"
 
 namespace sslpv::bench {
 

@@ -18,11 +18,11 @@
 #include <vector>
 
 #include "bench/device_peaks.h"
-#include "gpu/device.h"
+#include "gpu/vk/device.h"
 #include "gpu/vulkan_renderer.h"
 #include "bench/int_list.h"
-#include "volume/cpu_renderer.h"
-#include "volume/scene.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/scene/scene.h"
 
 namespace {
 using namespace sslpv;

@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <vector>
 
-#include "gpu/compute.h"
-#include "gpu/device.h"
-#include "gpu/resources.h"
+#include "gpu/vk/compute.h"
+#include "gpu/vk/device.h"
+#include "gpu/vk/resources.h"
 #include "shaders/spirv_library.h"
 
 namespace sslpv::bench {

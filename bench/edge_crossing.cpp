@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "bench/band_profile.h"
-#include "volume/material.h"
-#include "volume/scene.h"
+#include "volume/scene/material.h"
+#include "volume/scene/scene.h"
 
 namespace {
 

@@ -2,7 +2,7 @@
 // lights orbit the camera's target about the vertical axis by a small angle per frame (as a
 // user dragging a light, or an animated one, would see it), or, with --animate T0, whose
 // deformers advance from time T0 by --step-time per frame (a slowly bending bar, re-voxelized
-// and resampled every frame), and prints volume/temporal_metrics.h's motion and flicker, for
+// and resampled every frame), and prints volume/eval/temporal_metrics.h's motion and flicker, for
 // the step and for twice it. A smooth change's flicker/motion doubles with the step; flicker
 // from texels or cells switching does not. Each frame warm-starts from the last, as a live
 // preview does. Prints a table; not a test.
@@ -20,9 +20,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "bench/int_list.h"
-#include "volume/cpu_renderer.h"
-#include "volume/scene.h"
-#include "volume/temporal_metrics.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/scene/scene.h"
+#include "volume/eval/temporal_metrics.h"
 
 namespace {
 using namespace sslpv;

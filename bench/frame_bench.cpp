@@ -15,11 +15,11 @@
 
 #include "bench/bench_meshes.h"
 #include "bench/device_peaks.h"
-#include "gpu/device.h"
+#include "gpu/vk/device.h"
 #include "gpu/vulkan_renderer.h"
-#include "volume/cpu_renderer.h"
-#include "volume/material.h"
-#include "volume/scene.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/scene/material.h"
+#include "volume/scene/scene.h"
 
 namespace {
 using namespace sslpv;

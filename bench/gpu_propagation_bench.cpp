@@ -48,11 +48,11 @@
 #include <vector>
 
 #include "bench/device_peaks.h"
-#include "gpu/compute.h"
-#include "gpu/gpu_propagation.h"
+#include "gpu/vk/compute.h"
+#include "gpu/passes/gpu_propagation.h"
 #include "shaders/spirv_library.h"
-#include "volume/lpv_constants.h"
-#include "volume/lpv_stages.h"
+#include "device_shared/lpv_constants.h"
+#include "volume/lpv/lpv_stages.h"
 
 namespace {
 using namespace sslpv;

@@ -24,8 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "volume/error.h"
-#include "volume/material_set.h"
+#include "volume/core/error.h"
+#include "volume/material/material_set.h"
 
 namespace fs = std::filesystem;
 using sslpv::MaterialSet;

@@ -3,7 +3,7 @@
 // whole image's mean radiance per channel.
 #include <glm/vec3.hpp>
 
-#include "volume/image_io.h"
+#include "volume/core/image_io.h"
 
 namespace sslpv::bench {
 

@@ -24,12 +24,12 @@
 #include <string>
 #include <vector>
 
-#include "volume/image_metrics.h"
+#include "volume/eval/image_metrics.h"
 #include "editor/edit_session.h"
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 #if __has_include(<vulkan/vulkan.h>)
-#include "gpu/vk_check.h"
+#include "gpu/vk/vk_check.h"
 #define PREVIEW_BENCH_GPU_ERROR 1
 #endif
 

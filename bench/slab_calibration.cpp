@@ -20,12 +20,12 @@
 
 #include "bench/image_mean.h"
 #include "bench/slab_scene.h"
-#include "volume/cpu_renderer.h"
-#include "volume/lpv_calibration.h"
-#include "volume/material.h"
-#include "volume/reference_tracer.h"
-#include "volume/slab_reflectance.h"
-#include "volume/scene.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/calibration/lpv_calibration.h"
+#include "volume/scene/material.h"
+#include "volume/reference/reference_tracer.h"
+#include "volume/reference/slab_reflectance.h"
+#include "volume/scene/scene.h"
 
 namespace {
 

@@ -13,10 +13,10 @@
 
 #include "bench/image_mean.h"
 #include "bench/slab_scene.h"
-#include "volume/cpu_renderer.h"
-#include "volume/material.h"
-#include "volume/reference_tracer.h"
-#include "volume/scene.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/scene/material.h"
+#include "volume/reference/reference_tracer.h"
+#include "volume/scene/scene.h"
 
 namespace {
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "volume/adding_doubling.h"
-#include "volume/material.h"
-#include "volume/scene.h"
+#include "volume/calibration/adding_doubling.h"
+#include "volume/scene/material.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv::bench {
 

@@ -2,7 +2,7 @@
 // wide and L thick, lit from above by a directional light along its normal and seen from
 // below along its normal: the radiance of its unlit face's middle, where the light comes
 // out only after crossing the slab. Ground truth is adding-doubling for the same slab
-// (volume/adding_doubling.h: exact transport for the laterally infinite slab with the
+// (volume/calibration/adding_doubling.h: exact transport for the laterally infinite slab with the
 // material's reduced albedo and a smooth boundary on both faces), so there is no noise to
 // average: the ratio is SSLPV's own error, up to the slab's finite width.
 //
@@ -16,9 +16,9 @@
 
 #include "bench/image_mean.h"
 #include "bench/slab_scene.h"
-#include "volume/cpu_renderer.h"
-#include "volume/material.h"
-#include "volume/scene.h"
+#include "volume/cpu/cpu_renderer.h"
+#include "volume/scene/material.h"
+#include "volume/scene/scene.h"
 
 namespace {
 

@@ -7,8 +7,8 @@
 #include <glm/common.hpp>
 #include <vector>
 
-#include "volume/material.h"
-#include "volume/material_set.h"
+#include "volume/scene/material.h"
+#include "volume/material/material_set.h"
 
 namespace sslpv {
 namespace {

@@ -20,7 +20,7 @@ class BrushControls {
   /// Defaults from the scene: set targets start at the base material (σt doubled, the
   /// colour halved, so a first stroke is visible), radius at 8 % of the object's longest
   /// world extent. The first channel is the artist's one: surface colour, scatter distance
-  /// and g (volume/artist_params.h), seen through the scene's boundary index `ior`.
+  /// and g (volume/material/artist_params.h), seen through the scene's boundary index `ior`.
   BrushControls(const MaterialSample& basePerSceneUnit, double objectWorldExtent, std::string sceneUnits,
                 double ior = 1.0);
 

@@ -14,8 +14,8 @@
 #include <stdexcept>
 
 #include "editor/brush_engine_impl.h"
-#include "volume/error.h"
-#include "volume/ray_scene.h"
+#include "volume/core/error.h"
+#include "volume/scene/ray_scene.h"
 
 namespace sslpv {
 

@@ -35,7 +35,7 @@
 // double; the result is stored as float.
 //
 // Channels: sigma_t (σt, RGB), sigma_s (σs, RGB), g; Colour (the artist's form: surface
-// colour, scatter distance and g, volume/artist_params.h) drives σt, σs and g with the
+// colour, scatter distance and g, volume/material/artist_params.h) drives σt, σs and g with the
 // targets artistToPhysical gives behind the target's boundary index; albedo_mfp drives σt
 // and σs with the targets σt = 1 / mean_free_path, σs = albedo · σt; preset drives σt, σs
 // (Jensen 2001, valid with g = 0) and g (target 0); All (smooth, erase only) drives σt, σs
@@ -79,10 +79,11 @@
 #include <string>
 #include <vector>
 
-#include "volume/artist_params.h"
-#include "volume/material.h"
-#include "volume/material_set.h"
-#include "volume/mesh.h"
+#include "volume/material/artist_params.h"
+#include "volume/scene/material.h"
+#include "volume/material/material_set.h"
+#include "volume/scene/mesh.h"
+#include "volume/lpv/resample.h"
 
 namespace sslpv {
 

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "editor/brush_engine.h"
-#include "volume/ray_scene.h"
+#include "volume/scene/ray_scene.h"
 
 namespace sslpv {
 namespace brush_detail {

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "editor/brush_engine_impl.h"
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 namespace sslpv {
 

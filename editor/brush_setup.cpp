@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "editor/brush_engine.h"
-#include "volume/error.h"
-#include "volume/scene.h"
+#include "volume/core/error.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 

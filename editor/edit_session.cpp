@@ -12,11 +12,11 @@
 #include <system_error>
 
 #include "editor/preview_worker.h"
-#include "volume/atomic_file.h"
-#include "volume/error.h"
-#include "volume/material_set.h"
-#include "volume/scene_file_edit.h"
-#include "volume/strict_json.h"
+#include "volume/core/atomic_file.h"
+#include "volume/core/error.h"
+#include "volume/material/material_set.h"
+#include "volume/scene/scene_file_edit.h"
+#include "volume/core/strict_json.h"
 
 namespace sslpv {
 namespace fs = std::filesystem;

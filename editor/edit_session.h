@@ -33,10 +33,10 @@
 
 #include "backend/backends.h"
 #include "editor/brush_engine.h"
-#include "volume/frame_report.h"
-#include "volume/error.h"
-#include "volume/image_io.h"
-#include "volume/scene.h"
+#include "volume/lpv/frame_report.h"
+#include "volume/core/error.h"
+#include "volume/core/image_io.h"
+#include "volume/scene/scene.h"
 
 namespace sslpv {
 

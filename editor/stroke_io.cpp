@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <utility>
 
-#include "volume/error.h"
-#include "volume/strict_json.h"
+#include "volume/core/error.h"
+#include "volume/core/strict_json.h"
 
 namespace sslpv {
 namespace {

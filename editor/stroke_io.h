@@ -20,7 +20,7 @@
 //                 albedo_mfp: {"albedo": [r,g,b] or number in [0,1],
 //                              "mean_free_path": [r,g,b] or number > 0, scene units}
 //                 preset: a Jensen 2001 name ("marble", "skin1", ...), painted with g = 0
-//   or, instead of "channel" and "value", the colour form (volume/artist_params.h; mode
+//   or, instead of "channel" and "value", the colour form (volume/material/artist_params.h; mode
 //   "set", which may then be omitted):
 //   "colour"    (or "color", not both) surface colour: the linear diffuse reflectance a
 //               thick slab shows, [r,g,b] or one number, in [0, Cmax]; Cmax = 1 - F(0) of

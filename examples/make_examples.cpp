@@ -25,7 +25,7 @@
 #include <utility>
 #include <vector>
 
-#include "volume/material_set.h"
+#include "volume/material/material_set.h"
 
 namespace fs = std::filesystem;
 

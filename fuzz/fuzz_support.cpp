@@ -5,7 +5,7 @@
 #include <fstream>
 #include <system_error>
 
-#include "volume/material_set.h"
+#include "volume/material/material_set.h"
 
 namespace sslpv::fuzz {
 namespace fs = std::filesystem;

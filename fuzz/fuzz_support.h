@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <string>
 
-#include "volume/error.h"
+#include "volume/core/error.h"
 
 namespace sslpv::fuzz {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "fuzz/fuzz_support.h"
-#include "volume/material_set.h"
+#include "volume/material/material_set.h"
 
 namespace {
 using namespace sslpv;

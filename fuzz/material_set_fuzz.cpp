@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "fuzz/fuzz_support.h"
-#include "volume/material_set.h"
+#include "volume/material/material_field.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace sslpv;

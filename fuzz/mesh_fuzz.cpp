@@ -1,11 +1,11 @@
-// Mesh import through assimp (volume/mesh.cpp) as a scene's "mesh": {"path": ...} uses it.
+// Mesh import through assimp (volume/scene/mesh.cpp) as a scene's "mesh": {"path": ...} uses it.
 // Assimp picks its importer by the file's extension, so the first input byte chooses one
 // of the formats users bring; the rest is the file.
 #include <cstdint>
 #include <iterator>
 
 #include "fuzz/fuzz_support.h"
-#include "volume/mesh.h"
+#include "volume/scene/mesh.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace sslpv;

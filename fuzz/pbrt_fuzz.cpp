@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include "fuzz/fuzz_support.h"
-#include "volume/pbrt_export.h"
-#include "volume/scene_object.h"
+#include "volume/eval/pbrt_export.h"
+#include "volume/material/scene_object.h"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   using namespace sslpv::fuzz;

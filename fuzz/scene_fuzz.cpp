@@ -1,10 +1,10 @@
-// The strict scene loader (volume/scene.cpp over volume/strict_json.cpp): any bytes as a
+// The strict scene loader (volume/scene/scene.cpp over volume/core/strict_json.cpp): any bytes as a
 // scene file must give a Scene or an InputError.
 #include <cstdint>
 #include <string>
 
 #include "fuzz/fuzz_support.h"
-#include "volume/scene.h"
+#include "volume/scene/scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace sslpv;

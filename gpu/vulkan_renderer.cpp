@@ -1,16 +1,17 @@
 #include "gpu/vulkan_renderer.h"
 
-#include "volume/lpv_calibration.h"
+#include "volume/calibration/lpv_calibration.h"
 
 #include <chrono>
 
-#include "gpu/gpu_inject.h"
-#include "gpu/gpu_propagation.h"
-#include "gpu/gpu_shade.h"
-#include "gpu/gpu_shadow_map.h"
-#include "gpu/gpu_voxelize.h"
-#include "gpu/graphics.h"
-#include "volume/material_set.h"
+#include "gpu/passes/gpu_inject.h"
+#include "gpu/passes/gpu_propagation.h"
+#include "gpu/passes/gpu_shade.h"
+#include "gpu/passes/gpu_shadow_map.h"
+#include "gpu/passes/gpu_voxelize.h"
+#include "gpu/vk/graphics.h"
+#include "volume/material/material_set.h"
+#include "volume/lpv/resample.h"
 
 namespace sslpv::gpu {
 namespace {

@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "gpu/device.h"
-#include "volume/frame_report.h"
-#include "volume/image_io.h"
-#include "volume/lpv_stages.h"
-#include "volume/renderer.h"
-#include "volume/scene.h"
-#include "volume/scene_object.h"
+#include "gpu/vk/device.h"
+#include "volume/lpv/frame_report.h"
+#include "volume/core/image_io.h"
+#include "volume/lpv/lpv_stages.h"
+#include "volume/lpv/renderer.h"
+#include "volume/scene/scene.h"
+#include "volume/material/scene_object.h"
 
 namespace sslpv::gpu {
 

@@ -7,13 +7,14 @@ SSLPV_BUILD="${SSLPV_BUILD:-$SSLPV_ROOT/build}"
 # clang-14 + libclang-rt-14-dev: the fuzz and sanitizer builds (libFuzzer's runtime is in
 # libclang-rt-14-dev; libfuzzer-14-dev only adds the standalone library, unused here).
 # curl: sanitize.sh tsan fetches Debian's oneTBB source package to instrument it.
+# python3: the layer check (scripts/check_layers.py), a CTest test.
 SSLPV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libglm-dev libembree-dev
   libassimp-dev nlohmann-json3-dev libcli11-dev libopenexr-dev libstb-dev
   libgtest-dev libgmock-dev libvtk9-dev xvfb xauth libglfw3-dev
   libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools vulkan-validationlayers
-  clang-14 libclang-rt-14-dev curl
+  clang-14 libclang-rt-14-dev curl python3
 )
 
 sslpv_install_packages() {

@@ -1,5 +1,5 @@
-// GLSL twin of sslpv::activeTrilinearWeights (volume/inject.cpp), reading the cell
-// coverage buffer of shaders/cell_coverage_shared.h. Used by injection and shading, which
+// GLSL twin of sslpv::activeTrilinearWeights (volume/cpu/inject.cpp), reading the cell
+// coverage buffer of device_shared/cell_coverage_shared.h. Used by injection and shading, which
 // must pick the same cells with the same weights as the CPU backend.
 //
 // Usage: define SSLPV_CELL_COVERAGE_BINDING (and SSLPV_CELL_COVERAGE_SET, default 0) to
@@ -11,11 +11,11 @@
 // Precision: the CPU computes grid coordinates in double, this in float (off by ~1e-6
 // cells at 32³). Renormalizing over the active corners divides that by their total raw
 // weight W, small at the edge of the active region, so weights there differ from the
-// CPU's by ~1e-6/W (tests/gpu_inject_test.cpp bounds this per coefficient).
+// CPU's by ~1e-6/W (tests/gpu/gpu_inject_test.cpp bounds this per coefficient).
 #ifndef SSLPV_CELL_COVERAGE_GLSL
 #define SSLPV_CELL_COVERAGE_GLSL
 
-#include "shaders/cell_coverage_shared.h"
+#include "device_shared/cell_coverage_shared.h"
 
 #ifndef SSLPV_CELL_COVERAGE_BINDING
 #error "define SSLPV_CELL_COVERAGE_BINDING before including shaders/cell_coverage.glsl"

@@ -1,5 +1,5 @@
-// GLSL twin of volume/fresnel.h (smooth dielectric boundary), line for line in float.
-// tests/gpu_shadow_map_test.cpp compares both over incidence angles and indices through
+// GLSL twin of volume/core/fresnel.h (smooth dielectric boundary), line for line in float.
+// tests/gpu/gpu_shadow_map_test.cpp compares both over incidence angles and indices through
 // shaders/fresnel_probe.comp.
 #ifndef SSLPV_FRESNEL_GLSL
 #define SSLPV_FRESNEL_GLSL

@@ -1,6 +1,6 @@
 #version 460
 // Evaluates the GLSL Fresnel and Snell twins (shaders/fresnel.glsl) for the test that
-// compares them with volume/fresnel.h: per case, input (unit incident direction, eta)
+// compares them with volume/core/fresnel.h: per case, input (unit incident direction, eta)
 // against the normal +z, output (refracted direction, reflectance).
 #extension GL_GOOGLE_include_directive : require
 #include "shaders/fresnel.glsl"

@@ -1,9 +1,9 @@
 #version 460
-// Test probe for tests/gpu_layout_test.cpp: copies every field of the shared records, read
+// Test probe for tests/gpu/gpu_layout_test.cpp: copies every field of the shared records, read
 // by name as GLSL lays them out, into a flat buffer in declaration order. The test fills
 // the records from C++ with distinct values and checks each lands where C++ put it.
 #extension GL_GOOGLE_include_directive : require
-#include "shaders/lpv_shared.h"
+#include "device_shared/lpv_shared.h"
 
 layout(local_size_x = 1) in;
 

@@ -1,5 +1,5 @@
 #version 460
-// Injection: the twin of sslpv::injectSamples (volume/inject.cpp). Each GpuFluxSample
+// Injection: the twin of sslpv::injectSamples (volume/cpu/inject.cpp). Each GpuFluxSample
 // that hit the object adds, in the seed scheme, a clamped cosine lobe holding flux/π about
 // its refracted direction, half a cell inside the surface (a full cell deeper when no
 // active cell is near), spread over active cells with activeTrilinearWeights; in the
@@ -13,9 +13,9 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_atomic_float : require
 
-#include "volume/lpv_constants.h"
-#include "shaders/flux_sample_shared.h"
-#include "shaders/cell_coverage_shared.h"
+#include "device_shared/lpv_constants.h"
+#include "device_shared/flux_sample_shared.h"
+#include "device_shared/cell_coverage_shared.h"
 
 layout(local_size_x = SSLPV_INJECT_GROUP) in;
 

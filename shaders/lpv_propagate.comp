@@ -1,6 +1,6 @@
 #version 460
 // One LPV propagation step (normalize + transfer + factors + accumulate, fused), the GPU
-// twin of volume/propagate.cpp, run only over the occupied part of the grid.
+// twin of volume/cpu/propagate.cpp, run only over the occupied part of the grid.
 //
 // A workgroup is one work item: a tile of SSLPV_TILE_X x ROWS cells in x, y marching
 // through a run of slices [zBegin, zEnd) in which the tile holds active cells (the host

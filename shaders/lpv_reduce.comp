@@ -1,7 +1,7 @@
 #version 460
 // Sums the propagation step's per-item partial power sums into one row of step totals,
 // counts the step, and applies the --steps auto rule of decideAutoStop()
-// (volume/propagate.cpp): stop once, in every lit channel, the step added less than
+// (volume/cpu/propagate.cpp): stop once, in every lit channel, the step added less than
 // `autoTolerance` of the power accumulated so far and the geometric tail r/(1-r) times
 // the step is below `autoTailTolerance` of it; the tail's scale is left in the control
 // record for the accumulation. Keeping the decision on the GPU lets many steps go in one
@@ -9,8 +9,8 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
-#include "volume/lpv_constants.h"
-#include "shaders/lpv_shared.h"
+#include "device_shared/lpv_constants.h"
+#include "device_shared/lpv_shared.h"
 
 layout(local_size_x = SSLPV_REDUCE_GROUP) in;
 
@@ -23,7 +23,7 @@ layout(std430, binding = 8) writeonly buffer StepTotals { vec4 totals[]; };
 // One entry per subgroup (at least 1 lane per subgroup; the group is small).
 shared vec4 subgroupTotals[SSLPV_ENERGY_VEC4S][SSLPV_REDUCE_GROUP];
 
-/// chebyshevOmega() and chebyshevRate() of volume/propagate.cpp, in float.
+/// chebyshevOmega() and chebyshevRate() of volume/cpu/propagate.cpp, in float.
 float chebyshevOmega(int k, float rho) {
   if (!(rho > 0.0) || k < 1) return 1.0;
   return 2.0 / (1.0 + tanh(float(k) * acosh(1.0 / rho)) * sqrt(1.0 - rho * rho));

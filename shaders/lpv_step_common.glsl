@@ -10,8 +10,8 @@
 #ifndef SSLPV_LPV_STEP_COMMON_GLSL
 #define SSLPV_LPV_STEP_COMMON_GLSL
 
-#include "volume/lpv_constants.h"
-#include "shaders/lpv_shared.h"
+#include "device_shared/lpv_constants.h"
+#include "device_shared/lpv_shared.h"
 
 /// Tile rows along y (the tile is SSLPV_TILE_X wide).
 layout(constant_id = 0) const int ROWS = 8;

@@ -1,4 +1,4 @@
-// The L1 SH face-flux transfer of one LPV step, the GLSL twin of volume/propagate.cpp: the
+// The L1 SH face-flux transfer of one LPV step, the GLSL twin of volume/cpu/propagate.cpp: the
 // renormalized clamp of a source cell and the light it sends through the 5 faces of each
 // of its 6 neighbours, re-emitted there as cosine lobes. One vec4 holds one channel's
 // coefficients (c0, c1x, c1y, c1z).

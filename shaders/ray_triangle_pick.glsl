@@ -5,12 +5,12 @@
 // sphere the face normals differ, and with them Fresnel, refraction and shading.
 //
 // The crossing test itself (rayCrossesTriangle) is shared with the CPU ray caster,
-// which refines Embree's hit the same way: volume/ray_triangle_test.h.
+// which refines Embree's hit the same way: device_shared/ray_triangle_test.h.
 //
 // Needs, declared by the including shader: `positions` (vec4 per vertex), `indices`
 // (3 uint per triangle) and `vertexFans` (GpuMesh::vertexFans: vertexCount + 1 offsets
 // into the same array, then the triangles around each vertex).
-#include "volume/ray_triangle_test.h"
+#include "device_shared/ray_triangle_test.h"
 
 uvec3 triangleVertices(uint triangle) {
   return uvec3(indices[3u * triangle], indices[3u * triangle + 1u], indices[3u * triangle + 2u]);

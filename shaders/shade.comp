@@ -1,22 +1,22 @@
 #version 460
-// GPU twin of the per-pixel work of sslpv::shadeImage (volume/shade.cpp), on the
+// GPU twin of the per-pixel work of sslpv::shadeImage (volume/cpu/shade.cpp), on the
 // triangle the rasterizer found nearest at each pixel centre (shaders/shade.vert/.frag),
 // or the neighbour the exact ray crosses (shaders/ray_triangle_pick.glsl):
 // the pixel's camera ray meets the triangle's plane; the accumulated LPV is read half a
 // cell inside the surface (a full cell when no active cell is near) with the
 // coverage-weighted active trilinear weights of activeTrilinearWeights; radiance
 // L = T(θo)/η² · (1/(Aπ)) ∫_H G h I(ω) dω per channel, G the cell's exit gain and h its
-// exit angular shape (volume/exit_law.h; 1 in the seed scheme), plus the calibrated
-// scheme's single-scattering term (volume/single_scattering.h) where it is bound.
+// exit angular shape (volume/calibration/exit_law.h; 1 in the seed scheme), plus the calibrated
+// scheme's single-scattering term (volume/cpu/single_scattering.h) where it is bound.
 // Output: one vec4 per pixel, row 0 at
 // the top, (radiance, 1) on the surface (black where the ray leaves from inside or no
 // active cell is near), (0, 0, 0, 0) for the background.
 #extension GL_GOOGLE_include_directive : require
-#include "shaders/flux_sample_shared.h"
+#include "device_shared/flux_sample_shared.h"
 #include "shaders/fresnel.glsl"
-#include "shaders/shade_shared.h"
-#include "shaders/shadow_map_shared.h"
-#include "volume/lpv_constants.h"
+#include "device_shared/shade_shared.h"
+#include "device_shared/shadow_map_shared.h"
+#include "device_shared/lpv_constants.h"
 
 #define SSLPV_CELL_COVERAGE_BINDING 3
 #include "shaders/cell_coverage.glsl"
@@ -38,7 +38,7 @@ layout(std430, set = 0, binding = 6) readonly buffer VertexFans { uint vertexFan
 layout(std430, set = 0, binding = 7) readonly buffer ExitFactors { vec4 exitFactors[]; };
 // ExitLawTable::shape of the scene's η (gpu::uploadExitLaw).
 layout(std430, set = 0, binding = 8) readonly buffer ExitLaw { float exitLaw[]; };
-// The single-scattering term's inputs (volume/single_scattering.h), read only when
+// The single-scattering term's inputs (volume/cpu/single_scattering.h), read only when
 // push.gridDims.w (the number of shadow-map views) is above 0: per cell (σt' rgb, 0) and
 // (σs' rgb, 0) (gpu::uploadReducedMedium), and the shadow mapper's views and texel records.
 layout(std430, set = 0, binding = 9) readonly buffer Medium { vec4 medium[]; };
@@ -48,7 +48,7 @@ layout(push_constant) uniform Push { GpuShadePush push; };
 
 #include "shaders/ray_triangle_pick.glsl"
 
-// Twin of sslpv::exitLawShape (volume/exit_law.cpp), line for line: bilinear in
+// Twin of sslpv::exitLawShape (volume/calibration/exit_law.cpp), line for line: bilinear in
 // t = sqrt(1 - α') and μo; `j`/`fm` are the μo part, shared by a pixel's cells.
 float exitLawShape(float albedo, int j, float fm) {
   const float t = sqrt(clamp(1.0 - albedo, 0.0, 1.0)) * float(SSLPV_EXIT_LAW_ALBEDO_INTERVALS);
@@ -61,7 +61,7 @@ float exitLawShape(float albedo, int j, float fm) {
   return a + ft * (b - a);
 }
 
-// Twin of reducedMediumAt (volume/single_scattering.cpp).
+// Twin of reducedMediumAt (volume/cpu/single_scattering.cpp).
 bool reducedMediumAt(CellGrid grid, vec3 q, out vec3 extinction, out vec3 scattering) {
   uint cells[8];
   float weights[8];
@@ -75,7 +75,7 @@ bool reducedMediumAt(CellGrid grid, vec3 q, out vec3 extinction, out vec3 scatte
   return used > 0;
 }
 
-// Twin of texelThrough (volume/single_scattering.cpp): the texel record of view v whose
+// Twin of texelThrough (volume/cpu/single_scattering.cpp): the texel record of view v whose
 // ray passes through q (-1 where q is outside the view), and q's distance along that ray.
 int texelThrough(uint v, vec3 q, out float along) {
   const GpuShadowView view = shadowViews[v];
@@ -100,7 +100,7 @@ int texelThrough(uint v, vec3 q, out float along) {
   return int(view.texels.y) + y * size + x;
 }
 
-// Twin of the EntryTexel castShadowMap writes (volume/shadow_map.cpp) from a texel record
+// Twin of the EntryTexel castShadowMap writes (volume/cpu/shadow_map.cpp) from a texel record
 // of view v: E T cos θi / cos θt (0 for a miss), the hit's distance along the texel ray,
 // cos θi / cos θt, and ∇P = −n / cos θt.
 void entryOf(uint v, int record, out vec3 irradiance, out float distance, out float pathScale, out vec3 gradient) {
@@ -127,17 +127,17 @@ void entryOf(uint v, int record, out vec3 irradiance, out float distance, out fl
   irradiance = texel.flux.rgb * (pathScale / across);
 }
 
-// Twin of meanDecay (volume/single_scattering.cpp): the mean of e^{-x u} over u in [0, 1].
+// Twin of meanDecay (volume/cpu/single_scattering.cpp): the mean of e^{-x u} over u in [0, 1].
 float meanDecay(float x) { return abs(x) < 1e-2 ? 1.0 - x * (0.5 - x / 6.0) : (1.0 - exp(-x)) / x; }
 
-// Twin of exponentialSegment (volume/single_scattering.cpp): ∫_a^b exp(−(c + r s)) ds.
+// Twin of exponentialSegment (volume/cpu/single_scattering.cpp): ∫_a^b exp(−(c + r s)) ds.
 float exponentialSegment(float c, float r, float a, float b) {
   if (!(b > a)) return 0.0;
   const float x = r * (b - a);
   return x >= 0.0 ? exp(-(c + r * a)) * (b - a) * meanDecay(x) : exp(-(c + r * b)) * (b - a) * meanDecay(-x);
 }
 
-// Twin of singleScatteringIntegral (volume/single_scattering.cpp); `end` < 0 stands for ∞.
+// Twin of singleScatteringIntegral (volume/cpu/single_scattering.cpp); `end` < 0 stands for ∞.
 float singleScatteringIntegral(float sigma, float p0, float k, float end) {
   if (!(sigma > 0.0) || end == 0.0) return 0.0;
   bool infinite = end < 0.0;
@@ -162,7 +162,7 @@ float singleScatteringIntegral(float sigma, float p0, float k, float end) {
   return total;
 }
 
-// Twin of viewRayExit (volume/single_scattering.cpp); -1 for ∞.
+// Twin of viewRayExit (volume/cpu/single_scattering.cpp); -1 for ∞.
 float viewRayExit(CellGrid grid, vec3 p, vec3 into, float extinction) {
   const int across = max(grid.dims.x, max(grid.dims.y, grid.dims.z));
   const int steps = int(min(float(across), ceil(float(SSLPV_SINGLE_SCATTERING_EXIT_DEPTH) / (extinction * grid.cellSize))));
@@ -174,7 +174,7 @@ float viewRayExit(CellGrid grid, vec3 p, vec3 into, float extinction) {
   return -1.0;
 }
 
-// Twin of singleScatteredRadiance (volume/single_scattering.cpp).
+// Twin of singleScatteredRadiance (volume/cpu/single_scattering.cpp).
 vec3 singleScatteredRadiance(CellGrid grid, vec3 p, vec3 inward, vec3 into) {
   const float cellSize = grid.cellSize;
   vec3 q = p + 0.5 * cellSize * inward;

@@ -1,10 +1,10 @@
 #version 460
 // Shading rasterization (visibility): the mesh seen from the camera of shadeImage
-// (volume/shade.cpp), vertices pulled from the mesh buffers (3 per triangle,
+// (volume/cpu/shade.cpp), vertices pulled from the mesh buffers (3 per triangle,
 // non-indexed), projected so that pixel centres are exactly the CPU's camera rays. The
 // fragment shader keeps the nearest triangle per pixel; shaders/shade.comp shades it.
 #extension GL_GOOGLE_include_directive : require
-#include "shaders/shade_shared.h"
+#include "device_shared/shade_shared.h"
 
 layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Indices { uint indices[]; };

@@ -1,15 +1,15 @@
 #version 460
 // Shadow-map resolve, the GPU twin of the per-hit work of sslpv::castShadowMap
-// (volume/shadow_map.cpp): per texel of every view, the texel ray (ShadowView::texelRay),
+// (volume/cpu/shadow_map.cpp): per texel of every view, the texel ray (ShadowView::texelRay),
 // its hit on the triangle it crosses (the rasterized one or, within the rasterizer's
 // snapping of an edge, a neighbour: shaders/ray_triangle_pick.glsl; for a texel the
 // rasterizer left empty, one its neighbouring texels rasterized), the outward
 // geometric normal, the light arriving (I dω or E dA, nothing outside a spot's cone), Fresnel transmittance and
 // the refracted direction, written as one GpuFluxSample (misses: all zero).
 #extension GL_GOOGLE_include_directive : require
-#include "shaders/flux_sample_shared.h"
+#include "device_shared/flux_sample_shared.h"
 #include "shaders/fresnel.glsl"
-#include "shaders/shadow_map_shared.h"
+#include "device_shared/shadow_map_shared.h"
 
 layout(local_size_x = SSLPV_SHADOW_RESOLVE_GROUP, local_size_y = SSLPV_SHADOW_RESOLVE_GROUP) in;
 

@@ -1,9 +1,9 @@
 #version 460
-// Shadow-map rasterization, one view of shaders/shadow_map_shared.h per draw: vertices
+// Shadow-map rasterization, one view of device_shared/shadow_map_shared.h per draw: vertices
 // pulled from the mesh buffers (3 per triangle, non-indexed), projected so that pixel
 // centres are exactly the texel rays of sslpv::ShadowView::texelRay.
 #extension GL_GOOGLE_include_directive : require
-#include "shaders/shadow_map_shared.h"
+#include "device_shared/shadow_map_shared.h"
 
 layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Indices { uint indices[]; };

@@ -1,9 +1,9 @@
 #version 460
 // Per cell: inside from the parity of the crossings below its centre, coverage from its
 // packed nearest-triangle word (vox_cellCoverage). Twin of the coverage loop in
-// volume/voxelize_parity.cpp (parityInside).
+// volume/lpv/voxelize_parity.cpp (parityInside).
 #extension GL_GOOGLE_include_directive : require
-#include "shaders/voxelize_shared.h"
+#include "device_shared/voxelize_shared.h"
 
 layout(local_size_x = SSLPV_VOX_CELL_GROUP) in;
 

@@ -2,11 +2,11 @@
 // Per triangle: scatter the packed nearest distance + direction to every cell centre
 // within SSLPV_VOX_WHOLE_CELL (atomic minimum), and toggle the crossing bit of every
 // z column its xy projection covers (atomic xor). The CPU twin is
-// volume/voxelize_parity.cpp (scatterDistance, scatterParity, edgeSign). Both enumerate
+// volume/lpv/voxelize_parity.cpp (scatterDistance, scatterParity, edgeSign). Both enumerate
 // a superset of the cells and columns the exact tests keep (any superset gives the same
-// minimum and the same crossings); every value comes from shaders/voxelize_shared.h.
+// minimum and the same crossings); every value comes from device_shared/voxelize_shared.h.
 #extension GL_GOOGLE_include_directive : require
-#include "shaders/voxelize_shared.h"
+#include "device_shared/voxelize_shared.h"
 
 layout(local_size_x = SSLPV_VOX_TRIANGLE_GROUP) in;
 
@@ -85,7 +85,7 @@ void scatterDistance(vec3 a, vec3 b, vec3 c, ivec3 dims) {
   }
 }
 
-// Twin of edgeSign() in volume/voxelize_parity.cpp: the sign of the edge function of
+// Twin of edgeSign() in volume/lpv/voxelize_parity.cpp: the sign of the edge function of
 // p->q at column c, exact through 64-bit products (imulExtended), evaluated in one
 // canonical direction of the edge, ties broken as if c moved by (eps, eps^2).
 int edgeSign(ivec2 p, ivec2 q, ivec2 c) {

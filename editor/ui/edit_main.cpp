@@ -24,8 +24,8 @@
 #include "editor/edit_session.h"
 #include "editor/ui/edit_input.h"
 #include "editor/ui/edit_window.h"
-#include "volume/atomic_file.h"
-#include "volume/error.h"
+#include "volume/core/atomic_file.h"
+#include "volume/core/error.h"
 
 namespace {
 

@@ -29,7 +29,8 @@
 #include <glm/gtc/matrix_inverse.hpp>
 
 #include "editor/ui/slice_views.h"
-#include "volume/error.h"
+#include "volume/core/error.h"
+#include "volume/material/material_field.h"
 
 namespace sslpv {
 namespace {

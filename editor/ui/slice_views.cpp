@@ -1,4 +1,5 @@
 #include "editor/ui/slice_views.h"
+#include "volume/material/material_field.h"
 
 #include <vtkActor.h>
 #include <vtkCamera.h>

@@ -12,8 +12,8 @@
 #include <glm/vec3.hpp>
 
 #include "editor/legend_range.h"
-#include "volume/material_set.h"
-#include "volume/mesh.h"
+#include "volume/material/material_field.h"
+#include "volume/scene/mesh.h"
 
 class vtkActor;
 class vtkColorTransferFunction;
