@@ -76,7 +76,7 @@ void VulkanRenderer::setTime(double t) {
   dirty_.geometryChanged();
 }
 
-void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& report) {
+double VulkanRenderer::runVoxelize(const LpvSettings& settings, RenderReport& report) {
   const GridFrame frame = makeGridFrame(object_.gridBounds(), settings.resolution);
   requireLpvMemory(frame, vulkanLpvBytes(frame), "vulkan");
   const bool sameFrame = voxelizer_ && voxelizer_->frame().dims == frame.dims &&
@@ -84,7 +84,6 @@ void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& repo
   if (!sameFrame) voxelizer_ = std::make_unique<GpuVoxelizer>(device_, frame);
   // GpuMesh holds the vec4 positions and uint indices the voxelizer reads: one upload.
   const GpuVoxelizeTimings times = voxelizer_->run(mesh_->positions(), mesh_->indices(), mesh_->triangleCount());
-  report.times.voxelize = times.totalMs();
   // The occupancy comes back to the host: the step factors and the brick list of the
   // propagation are built there, together with the resampled material.
   material_ = MaterialGrid{};
@@ -96,9 +95,11 @@ void VulkanRenderer::rebuildGrid(const LpvSettings& settings, RenderReport& repo
   // pipelines and buffers stay: resample() hands it the new factors and active cells.
   if (!sameFrame) propagator_.reset();
   report.frame = frame;
+  report.triangles = object_.mesh().triangles.size();
+  return times.totalMs();
 }
 
-void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report) {
+double VulkanRenderer::runResample(const LpvSettings& settings, RenderReport& report) {
   const auto start = std::chrono::steady_clock::now();
   if (dirty_.resampleRegion() && propagator_) {
     report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion()).count();
@@ -119,110 +120,73 @@ void VulkanRenderer::resample(const LpvSettings& settings, RenderReport& report)
   for (unsigned char a : factors_.active) report.activeCells += a;
   if (propagator_) {
     propagator_->setFactors(factors_);
-    report.times.resample = msSince(start);
-  } else {
-    report.times.resample = msSince(start);
-    // Pipeline creation and shader compilation happen once per grid: setup, not resampling.
-    const auto created = std::chrono::steady_clock::now();
-    propagator_ = std::make_unique<GpuPropagator>(device_, material_.frame, factors_);
-    loadMs_ += msSince(created);
+    return msSince(start);
   }
+  const double resampleMs = msSince(start);
+  // Pipeline creation and shader compilation happen once per grid: setup, not resampling.
+  const auto created = std::chrono::steady_clock::now();
+  propagator_ = std::make_unique<GpuPropagator>(device_, material_.frame, factors_);
+  loadMs_ += msSince(created);
+  return resampleMs;
 }
 
 std::vector<std::uint32_t> VulkanRenderer::readTriangles() const {
   return shader_ ? shader_->readTriangles() : std::vector<std::uint32_t>{};
 }
 
-Image VulkanRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
-  const auto frameStart = std::chrono::steady_clock::now();
-  if (lastSettings_) dirty_.settingsChanged(*lastSettings_, settings);
-  lastSettings_ = settings;
-  // A new grid invalidates everything that lives on it.
-  if (dirty_.dirty(Stage::Voxelize)) dirty_.everything();
-
-  RenderReport& report = last_;
-  report.backend = "vulkan (" + device_.name() + ")";
-  report.times = StageTimes{};
-  report.triangles = object_.mesh().triangles.size();
-  report.resampledCells = 0;
-
-  if (dirty_.dirty(Stage::Voxelize))
-    rebuildGrid(settings, report);
-  else
-    report.times.markCached(Stage::Voxelize);
-
-  if (dirty_.dirty(Stage::Resample))
-    resample(settings, report);
-  else
-    report.times.markCached(Stage::Resample);
-
-  if (dirty_.dirty(Stage::ShadowMap)) {
-    if (!shadowMapper_ || shadowMapper_->size() != settings.shadowMap) {
-      shadowMapper_ = std::make_unique<GpuShadowMapper>(device_, *mesh_, settings.shadowMap);
-      lightsUploaded_ = false;
-    }
-    if (!lightsUploaded_) {
-      shadowMapper_->setLights(scene_.lights, scene_.material.ior);
-      lightsUploaded_ = true;
-    }
-    report.times.shadowMap = shadowMapper_->run();
-    // Texel counts and culling only: hits and flux would need every texel record read
-    // back each frame (4 MB per 256² view); GpuShadowMapper::stats() gives them on demand.
-    report.lights.clear();
-    for (const GpuShadowLight& placed : shadowMapper_->lights()) {
-      ShadowMapStats stats;
-      stats.texels = placed.sampleCount;
-      stats.culled = placed.culled;
-      report.lights.push_back(stats);
-    }
-  } else {
-    report.times.markCached(Stage::ShadowMap);
+double VulkanRenderer::runShadowMaps(const LpvSettings& settings, RenderReport& report) {
+  if (!shadowMapper_ || shadowMapper_->size() != settings.shadowMap) {
+    shadowMapper_ = std::make_unique<GpuShadowMapper>(device_, *mesh_, settings.shadowMap);
+    lightsUploaded_ = false;
   }
-
-  if (dirty_.dirty(Stage::Injection)) {
-    report.injection = injector_->run(shadowMapper_->samples(), shadowMapper_->sampleCount(), *cellCoverage_,
-                                      material_.frame, propagator_->sourceField(), true, calibratedInjection_.get());
-    report.times.injection = injector_->lastRunMs();
-  } else {
-    report.times.markCached(Stage::Injection);
+  if (!lightsUploaded_) {
+    shadowMapper_->setLights(scene_.lights, scene_.material.ior);
+    lightsUploaded_ = true;
   }
-
-  if (dirty_.dirty(Stage::Propagation)) {
-    PropagationOptions options;
-    options.steps = settings.steps;
-    options.autoSteps = settings.autoSteps;
-    options.chebyshev = true;
-    report.propagation = propagator_->runOnDevice(options);
-    const GpuPropagationTimings& t = propagator_->timings();
-    report.times.propagation = t.propagateMs + t.reduceMs;
-  } else {
-    report.times.markCached(Stage::Propagation);
+  const double ms = shadowMapper_->run();
+  // Texel counts and culling only: hits and flux would need every texel record read
+  // back each frame (4 MB per 256² view); GpuShadowMapper::stats() gives them on demand.
+  report.lights.clear();
+  for (const GpuShadowLight& placed : shadowMapper_->lights()) {
+    ShadowMapStats stats;
+    stats.texels = placed.sampleCount;
+    stats.culled = placed.culled;
+    report.lights.push_back(stats);
   }
+  return ms;
+}
 
-  if (dirty_.dirty(Stage::Shading)) {
-    if (!shader_ || shader_->width() != scene_.camera.width || shader_->height() != scene_.camera.height)
-      shader_ = std::make_unique<GpuShader>(device_, *mesh_, scene_.camera.width, scene_.camera.height);
-    // The scene's η is fixed for the renderer: one table (built once per process and η).
-    if (!exitLaw_) exitLaw_ = std::make_unique<Buffer>(uploadExitLaw(device_, exitLawTable(scene_.material.ior)));
-    GpuSingleScattering single;
-    if (reducedMedium_) {
-      single.medium = reducedMedium_.get();
-      single.views = &shadowMapper_->viewRecords();
-      single.samples = &shadowMapper_->samples();
-      single.viewCount = std::uint32_t(shadowMapper_->views().size());
-    }
-    image_ = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, *exitFactors_, *exitLaw_,
-                            material_.frame, scene_.material.ior, &single);
-    report.times.shading = shader_->lastShadeMs();
-  } else {
-    report.times.markCached(Stage::Shading);
+double VulkanRenderer::runInjection(RenderReport& report) {
+  report.injection = injector_->run(shadowMapper_->samples(), shadowMapper_->sampleCount(), *cellCoverage_,
+                                    material_.frame, propagator_->sourceField(), true, calibratedInjection_.get());
+  return injector_->lastRunMs();
+}
+
+double VulkanRenderer::runPropagation(const LpvSettings& settings, RenderReport& report) {
+  PropagationOptions options;
+  options.steps = settings.steps;
+  options.autoSteps = settings.autoSteps;
+  options.chebyshev = true;
+  report.propagation = propagator_->runOnDevice(options);
+  const GpuPropagationTimings& t = propagator_->timings();
+  return t.propagateMs + t.reduceMs;
+}
+
+double VulkanRenderer::runShading(Image& image) {
+  if (!shader_ || shader_->width() != scene_.camera.width || shader_->height() != scene_.camera.height)
+    shader_ = std::make_unique<GpuShader>(device_, *mesh_, scene_.camera.width, scene_.camera.height);
+  // The scene's η is fixed for the renderer: one table (built once per process and η).
+  if (!exitLaw_) exitLaw_ = std::make_unique<Buffer>(uploadExitLaw(device_, exitLawTable(scene_.material.ior)));
+  GpuSingleScattering single;
+  if (reducedMedium_) {
+    single.medium = reducedMedium_.get();
+    single.views = &shadowMapper_->viewRecords();
+    single.samples = &shadowMapper_->samples();
+    single.viewCount = std::uint32_t(shadowMapper_->views().size());
   }
-
-  dirty_.clear();
-  report.times.load = loadMs_;
-  report.wallMs = msSince(frameStart);
-  if (reportOut) *reportOut = report;
-  return image_;
+  image = shader_->shade(scene_.camera, propagator_->accumulated(), *cellCoverage_, *exitFactors_, *exitLaw_,
+                         material_.frame, scene_.material.ior, &single);
+  return shader_->lastShadeMs();
 }
 
 }  // namespace sslpv::gpu

@@ -12,7 +12,7 @@
 #include "volume/lpv/frame_report.h"
 #include "volume/core/image_io.h"
 #include "volume/lpv/lpv_stages.h"
-#include "volume/lpv/renderer.h"
+#include "volume/lpv/staged_renderer.h"
 #include "volume/scene/scene.h"
 #include "volume/material/scene_object.h"
 
@@ -26,7 +26,9 @@ class GpuPropagator;
 class GpuShader;
 class Buffer;
 
-class VulkanRenderer final : public Renderer {
+/// Stage times in a frame's report are GPU times from timestamps (wall-clock for the CPU
+/// resampling and where the device has no timestamps).
+class VulkanRenderer final : public StagedRenderer {
  public:
   /// Loads the object as the CPU backend does (InputError on bad input) and uploads the
   /// mesh to `device`, which must outlive the renderer.
@@ -34,11 +36,6 @@ class VulkanRenderer final : public Renderer {
   ~VulkanRenderer() override;
   VulkanRenderer(const VulkanRenderer&) = delete;
   VulkanRenderer& operator=(const VulkanRenderer&) = delete;
-
-  /// Renders one frame with the given LPV settings, re-running only what changed.
-  /// Stage times in the report are GPU times from timestamps (wall-clock for the CPU
-  /// resampling and where the device has no timestamps).
-  Image render(const LpvSettings& settings, RenderReport* report = nullptr) override;
 
   void setCamera(const Camera& camera) override;
   void setLights(const std::vector<Light>& lights) override;
@@ -58,24 +55,25 @@ class VulkanRenderer final : public Renderer {
   const MaterialGrid& material() const { return material_; }
 
  private:
-  void rebuildGrid(const LpvSettings& settings, RenderReport& report);
-  void resample(const LpvSettings& settings, RenderReport& report);
+  double runVoxelize(const LpvSettings& settings, RenderReport& report) override;
+  double runResample(const LpvSettings& settings, RenderReport& report) override;
+  double runShadowMaps(const LpvSettings& settings, RenderReport& report) override;
+  double runInjection(RenderReport& report) override;
+  double runPropagation(const LpvSettings& settings, RenderReport& report) override;
+  double runShading(Image& image) override;
 
   const VulkanDevice& device_;
   Scene scene_;
   SceneObject object_;
-  double loadMs_ = 0.0;
   std::unique_ptr<GpuMesh> mesh_;
 
-  StageDirty dirty_;
   bool lightsUploaded_ = false;
-  std::optional<LpvSettings> lastSettings_;
   MaterialGrid material_;
   StepFactors factors_;
   std::unique_ptr<Buffer> exitFactors_;  ///< factors_' exit gain and reduced albedo on the device, for shading
   /// factors_' reduced σt' and σs' for the single-scattering term (calibrated scheme), else null
   std::unique_ptr<Buffer> reducedMedium_;
-    std::unique_ptr<Buffer> calibratedInjection_;  ///< factors_' injection record (calibrated scheme), else null
+  std::unique_ptr<Buffer> calibratedInjection_;  ///< factors_' injection record (calibrated scheme), else null
   std::unique_ptr<Buffer> exitLaw_;      ///< exitLawTable(scene_.material.ior), uploaded at the first shading
   std::unique_ptr<GpuVoxelizer> voxelizer_;
   std::unique_ptr<Buffer> cellCoverage_;
@@ -83,8 +81,6 @@ class VulkanRenderer final : public Renderer {
   std::unique_ptr<GpuInjector> injector_;
   std::unique_ptr<GpuPropagator> propagator_;
   std::unique_ptr<GpuShader> shader_;
-  RenderReport last_;
-  Image image_;
 };
 
 }  // namespace sslpv::gpu

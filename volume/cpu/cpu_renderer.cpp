@@ -77,129 +77,105 @@ void CpuRenderer::setTime(double t) {
   warm_.shell.clear();
 }
 
-Image CpuRenderer::render(const LpvSettings& settings, RenderReport* reportOut) {
-  Stopwatch frameWatch;
-  if (lastSettings_) {
-    dirty_.settingsChanged(*lastSettings_, settings);
-    if (lastSettings_->resolution != settings.resolution || lastSettings_->scheme != settings.scheme ||
-        lastSettings_->steps != settings.steps || lastSettings_->autoSteps != settings.autoSteps)
-      warm_.clear();
-  }
-  lastSettings_ = settings;
+void CpuRenderer::settingsChanging(const LpvSettings& before, const LpvSettings& after) {
+  if (before.resolution != after.resolution || before.scheme != after.scheme || before.steps != after.steps ||
+      before.autoSteps != after.autoSteps)
+    warm_.clear();
+}
 
-  RenderReport& report = last_;
-  report.backend = "cpu";
-  report.times = StageTimes{};
-  report.times.load = loadMs_;
-  report.triangles = object_.mesh().triangles.size();
-  report.resampledCells = 0;
+double CpuRenderer::runVoxelize(const LpvSettings& settings, RenderReport& report) {
   Stopwatch watch;
+  material_ = MaterialGrid{};
+  material_.frame = makeGridFrame(object_.gridBounds(), settings.resolution);
+  requireLpvMemory(material_.frame, estimateLpvBytes(material_.frame), "cpu");
+  material_.meanChord = meanChordLength(object_.mesh());
+  // The twin of the GPU voxelizer, so both backends see the same occupancy.
+  material_.coverage = voxelizeCoverageParity(object_.mesh(), material_.frame);
+  coarse_.geometryChanged();
+  surface_.reset();
+  viewShadedOnce_ = false;
+  report.frame = material_.frame;
+  report.triangles = object_.mesh().triangles.size();
+  return watch.lapMs();
+}
 
-  if (dirty_.dirty(Stage::Voxelize)) {
-    material_ = MaterialGrid{};
-    material_.frame = makeGridFrame(object_.gridBounds(), settings.resolution);
-    requireLpvMemory(material_.frame, estimateLpvBytes(material_.frame), "cpu");
-    material_.meanChord = meanChordLength(object_.mesh());
-    // The twin of the GPU voxelizer, so both backends see the same occupancy.
-    material_.coverage = voxelizeCoverageParity(object_.mesh(), material_.frame);
-    coarse_.geometryChanged();
-    surface_.reset();
-    viewShadedOnce_ = false;
-    report.frame = material_.frame;
-    report.times.voxelize = watch.lapMs();
+double CpuRenderer::runResample(const LpvSettings& settings, RenderReport& report) {
+  Stopwatch watch;
+  if (dirty_.resampleRegion()) {
+    report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion()).count();
   } else {
-    report.times.markCached(Stage::Voxelize);
+    resampleMaterial(object_.field(), material_);
+    report.resampledCells = material_.frame.cellCount();
   }
+  factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
+  report.opticalThickness = factors_.opticalThickness;
+  report.activeCells = 0;
+  for (unsigned char a : factors_.active) report.activeCells += a;
+  return watch.lapMs();
+}
 
-  if (dirty_.dirty(Stage::Resample)) {
-    if (dirty_.resampleRegion()) {
-      report.resampledCells = resampleMaterialRegion(object_.field(), material_, *dirty_.resampleRegion()).count();
-    } else {
-      resampleMaterial(object_.field(), material_);
-      report.resampledCells = material_.frame.cellCount();
-    }
-    factors_ = computeStepFactors(material_, settings.scheme, scene_.material.ior);
-    report.opticalThickness = factors_.opticalThickness;
-    report.activeCells = 0;
-    for (unsigned char a : factors_.active) report.activeCells += a;
-    report.times.resample = watch.lapMs();
-  } else {
-    report.times.markCached(Stage::Resample);
+double CpuRenderer::runShadowMaps(const LpvSettings& settings, RenderReport& report) {
+  Stopwatch watch;
+  samples_.clear();
+  entries_.clear();
+  report.lights.clear();
+  for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
+    const Light& light = scene_.lights[l];
+    ShadowMapStats stats;
+    // The entry maps are filled whatever the scheme, so that switching to the calibrated
+    // one (the only reader) does not re-cast the maps.
+    auto lightSamples = castShadowMap(light, *rays_, object_.bounds(), settings.shadowMap, scene_.material.ior,
+                                      &stats, &entries_, int(l));
+    samples_.insert(samples_.end(), lightSamples.begin(), lightSamples.end());
+    report.lights.push_back(stats);
   }
+  return watch.lapMs();
+}
 
-  if (dirty_.dirty(Stage::ShadowMap)) {
-    samples_.clear();
-    entries_.clear();
-    report.lights.clear();
-    for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
-      const Light& light = scene_.lights[l];
-      ShadowMapStats stats;
-      // The entry maps are filled whatever the scheme, so that switching to the calibrated
-      // one (the only reader) does not re-cast the maps.
-      auto lightSamples = castShadowMap(light, *rays_, object_.bounds(), settings.shadowMap, scene_.material.ior,
-                                        &stats, &entries_, int(l));
-      samples_.insert(samples_.end(), lightSamples.begin(), lightSamples.end());
-      report.lights.push_back(stats);
-    }
-    report.times.shadowMap = watch.lapMs();
-  } else {
-    report.times.markCached(Stage::ShadowMap);
-  }
+double CpuRenderer::runInjection(RenderReport& report) {
+  Stopwatch watch;
+  injected_.resize(material_.frame);
+  report.injection =
+      injectSamples(samples_, material_, injected_, factors_.scheme == LpvScheme::Calibrated ? &factors_ : nullptr);
+  return watch.lapMs();
+}
 
-  if (dirty_.dirty(Stage::Injection)) {
-    injected_.resize(material_.frame);
-    report.injection = injectSamples(samples_, material_, injected_,
-                                     factors_.scheme == LpvScheme::Calibrated ? &factors_ : nullptr);
-    report.times.injection = watch.lapMs();
-  } else {
-    report.times.markCached(Stage::Injection);
-  }
+double CpuRenderer::runPropagation(const LpvSettings& settings, RenderReport& report) {
+  Stopwatch watch;
+  // Propagation consumes its source; the injected light is kept for the next re-run.
+  ShGrid field = injected_;
+  accumulated_.resize(material_.frame);
+  PropagationOptions options;
+  options.steps = settings.steps;
+  options.autoSteps = settings.autoSteps;
+  options.chebyshev = true;
+  options.warmStart = &warm_;
+  report.coarseStart = CoarseStartReport{};
+  if (coarseStartEnabled_ && !warm_.holds(material_.frame))
+    coarse_.start(object_, material_, factors_, settings.resolution, scene_.material.ior, samples_, options, warm_,
+                  &report.coarseStart);
+  report.propagation = propagate(material_, factors_, field, accumulated_, options);
+  return watch.lapMs();
+}
 
-  if (dirty_.dirty(Stage::Propagation)) {
-    // Propagation consumes its source; the injected light is kept for the next re-run.
-    ShGrid field = injected_;
-    accumulated_.resize(material_.frame);
-    PropagationOptions options;
-    options.steps = settings.steps;
-    options.autoSteps = settings.autoSteps;
-    options.chebyshev = true;
-    options.warmStart = &warm_;
-    report.coarseStart = CoarseStartReport{};
-    if (coarseStartEnabled_ && !warm_.holds(material_.frame))
-      coarse_.start(object_, material_, factors_, settings.resolution, scene_.material.ior, samples_, options, warm_,
-                    &report.coarseStart);
-    report.propagation = propagate(material_, factors_, field, accumulated_, options);
-    report.times.propagation = watch.lapMs();
-  } else {
-    report.times.markCached(Stage::Propagation);
-  }
-
-  if (dirty_.dirty(Stage::Shading)) {
-    const bool calibrated = factors_.scheme == LpvScheme::Calibrated;
-    const std::vector<EntryMap>* single = calibrated ? &entries_ : nullptr;
-    // The camera rays and the cells each pixel reads depend on the camera and the
-    // geometry only: a light move or a stroke re-shades without casting them again. A
-    // view is kept only from its second frame on: storing it costs a one-shot render or
-    // a camera drag (a new view every frame) more than tracing it (50 -> 150 ms at 512²).
-    if (!surface_ && viewShadedOnce_)
-      surface_ = std::make_unique<ShadingSurface>(
-          traceShadingSurface(scene_.camera, *rays_, material_, scene_.material.ior));
-    if (surface_)
-      image_ = shadeSurface(*surface_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
-                            &factors_.reducedAlbedo, single);
-    else
-      image_ = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
-                          &factors_.reducedAlbedo, single);
-    viewShadedOnce_ = true;
-    report.times.shading = watch.lapMs();
-  } else {
-    report.times.markCached(Stage::Shading);
-  }
-
-  dirty_.clear();
-  report.wallMs = frameWatch.lapMs();
-  if (reportOut) *reportOut = report;
-  return image_;
+double CpuRenderer::runShading(Image& image) {
+  Stopwatch watch;
+  const bool calibrated = factors_.scheme == LpvScheme::Calibrated;
+  const std::vector<EntryMap>* single = calibrated ? &entries_ : nullptr;
+  // The camera rays and the cells each pixel reads depend on the camera and the
+  // geometry only: a light move or a stroke re-shades without casting them again. A
+  // view is kept only from its second frame on: storing it costs a one-shot render or
+  // a camera drag (a new view every frame) more than tracing it (50 -> 150 ms at 512²).
+  if (!surface_ && viewShadedOnce_)
+    surface_ = std::make_unique<ShadingSurface>(traceShadingSurface(scene_.camera, *rays_, material_, scene_.material.ior));
+  if (surface_)
+    image = shadeSurface(*surface_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
+                         &factors_.reducedAlbedo, single);
+  else
+    image = shadeImage(scene_.camera, *rays_, material_, accumulated_, scene_.material.ior, &factors_.exitGain,
+                       &factors_.reducedAlbedo, single);
+  viewShadedOnce_ = true;
+  return watch.lapMs();
 }
 
 }  // namespace sslpv

@@ -11,7 +11,7 @@
 #include "volume/lpv/frame_report.h"
 #include "volume/core/image_io.h"
 #include "volume/lpv/lpv_stages.h"
-#include "volume/lpv/renderer.h"
+#include "volume/lpv/staged_renderer.h"
 #include "volume/scene/scene.h"
 #include "volume/material/scene_object.h"
 #include "volume/cpu/single_scattering.h"
@@ -22,7 +22,7 @@ struct ShadingSurface;
 
 class RayScene;
 
-class CpuRenderer final : public Renderer {
+class CpuRenderer final : public StagedRenderer {
  public:
   /// Loads and checks the mesh (closed), builds the ray-casting structure and loads the
   /// material set. Throws InputError on bad input.
@@ -30,10 +30,6 @@ class CpuRenderer final : public Renderer {
   ~CpuRenderer() override;
   CpuRenderer(const CpuRenderer&) = delete;
   CpuRenderer& operator=(const CpuRenderer&) = delete;
-
-  /// Renders one frame with the given LPV settings (they override the scene's),
-  /// re-running only what changed since the previous frame.
-  Image render(const LpvSettings& settings, RenderReport* report = nullptr) override;
 
   /// The next frame re-shades only. `camera` must be valid (as the scene loader checks).
   void setCamera(const Camera& camera) override;
@@ -62,14 +58,19 @@ class CpuRenderer final : public Renderer {
   const Scene& scene() const { return scene_; }
 
  private:
+  void settingsChanging(const LpvSettings& before, const LpvSettings& after) override;
+  double runVoxelize(const LpvSettings& settings, RenderReport& report) override;
+  double runResample(const LpvSettings& settings, RenderReport& report) override;
+  double runShadowMaps(const LpvSettings& settings, RenderReport& report) override;
+  double runInjection(RenderReport& report) override;
+  double runPropagation(const LpvSettings& settings, RenderReport& report) override;
+  double runShading(Image& image) override;
+
   Scene scene_;
-  double loadMs_ = 0;
   SceneObject object_;
   std::unique_ptr<RayScene> rays_;
 
   // Results kept between frames.
-  StageDirty dirty_;
-  std::optional<LpvSettings> lastSettings_;
   MaterialGrid material_;
   StepFactors factors_;
   std::vector<SurfaceFluxSample> samples_;
@@ -83,8 +84,6 @@ class CpuRenderer final : public Renderer {
   std::unique_ptr<ShadingSurface> surface_;  ///< null: the camera or the geometry changed
   bool viewShadedOnce_ = false;               ///< the current view was shaded before: keep it
   bool coarseStartEnabled_ = true;
-  RenderReport last_;
-  Image image_;
 };
 
 }  // namespace sslpv

@@ -1,8 +1,9 @@
 #pragma once
 // What every SSLPV backend offers a caller (the CLI, the viewer, the editor's preview,
 // the benchmarks): one frame at a time, re-running only the stages whose inputs changed.
-// CpuRenderer (volume/) and gpu::VulkanRenderer implement it; backend/backends.h is the
-// one place that chooses between them.
+// CpuRenderer (volume/cpu/) and gpu::VulkanRenderer implement it, both on the frame
+// skeleton of volume/lpv/staged_renderer.h; backend/backends.h is the one place that
+// chooses between them.
 #include <memory>
 #include <optional>
 #include <string>
