@@ -16,6 +16,13 @@
 
 #include "volume/core/error.h"
 
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(undefined_behavior_sanitizer)
+#include <sanitizer/common_interface_defs.h>
+#define SSLPV_CHILD_UNDER_SANITIZER 1
+#endif
+#endif
+
 namespace sslpv {
 namespace {
 
@@ -37,6 +44,14 @@ std::size_t physicalMemoryBytes() {
 [[noreturn]] void runChild(int fd, std::size_t addressLimit, const std::function<int(int)>& body) {
   // SIGINT, SIGTERM and SIGHUP too: the parent's handlers would remove the parent's temporaries.
   for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGPIPE, SIGINT, SIGTERM, SIGHUP}) ::signal(sig, SIG_DFL);
+#ifdef SSLPV_CHILD_UNDER_SANITIZER
+  // A parser that dies on a corrupt file is why this child exists: the parent reports its
+  // death as the file's error. Under ASan it dies more often (its operator new aborts on
+  // the absurd sizes OpenVDB's Blosc reader asks for, where the release build throws
+  // bad_alloc), and each death would call the callback a fuzzer set in the parent, which
+  // saves the input as a crash of the parent's (docs/design.md §1, Fuzzing).
+  __sanitizer_set_death_callback(nullptr);
+#endif
   // glibc's "malloc(): corrupted ...", assertion texts and the parser's own log would reach
   // the user's terminal before the one-line error the parent reports; a flush of the
   // parent's inherited stdout buffer would duplicate its output.
