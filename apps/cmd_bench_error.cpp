@@ -103,9 +103,9 @@ std::string cacheProblem(const fs::path& exr, const fs::path& side, const Refere
 Reference obtainReference(const std::string& sceneArg, const Scene& scene, const fs::path& cacheDir, int spp,
                           std::uint64_t seed) {
   const ReferenceTracer tracer(scene);
-  // Dielectric objects' references connect lights exactly through the boundary: flat faces
-  // since 2026-11-29 (with internal reflections since 2026-11-30) and curved ones since
-  // 2026-11-30, unlike the references earlier versions cached under the same scene content.
+  // Dielectric objects' references connect lights exactly through the boundary (flat faces,
+  // internal reflections, curved meshes faceted); references that earlier versions cached
+  // under the same scene content did not, so the connection kind is part of the cache key.
   const char* connection = "";
   switch (tracer.lightConnection()) {
     case ReferenceTracer::LightConnection::StraightLine: break;

@@ -2,76 +2,8 @@
 // The brush engine: paints σt, σs and g into a material set's OpenVDB grids (docs/design.md
 // §4), with an unbounded, exact undo/redo history. Headless (no VTK, no
 // Vulkan): `sslpv paint` and the editor drive the same code.
-//
-// Space. Painting happens in the object's rest space, which is the grids' space. Stroke
-// points, rays, the radius and the depth are given in world space; points map through the
-// inverse of the scene transform (a similarity: radius_rest = radius / scale). Voxel
-// (i,j,k) sits at the grid transform's indexToWorld(i,j,k) (OpenVDB's cell-centred
-// convention; the grid's "world" is the rest space).
-//
-// Material of a voxel. A voxel inactive in a grid takes the base material for that grid
-// (docs/design.md §4). When the brush writes a voxel it makes its whole material explicit: the
-// voxel becomes active in all three grids (σt, σs, g), unless the result equals the base
-// material exactly in all three, in which case it becomes inactive in all three (value set
-// to each grid's background). So erasing restores the base, and smoothing an unpainted
-// region activates nothing. A missing g grid is created (background = base g).
-//
-// One dab at rest-space centre c, per voxel v at rest position p within the radius:
-//   u = |p - c| / radius_rest                       (u > 1: the voxel is not touched)
-//   w = falloff(u):
-//     constant  w = 1
-//     linear    w = 1 - u
-//     smooth    w = 1 - u²(3 - 2u)                   (1 - smoothstep(0, 1, u))
-//     gaussian  w = (exp(-4.5 u²) - exp(-4.5)) / (1 - exp(-4.5))
-//                                                    (σ = radius/3, shifted to reach 0 at u = 1)
-//   t = w · strength                                 (t <= 0: the voxel is not touched)
-// and every channel x the brush drives (read as the voxel's current material) becomes
-//   set       x' = x + t (target - x)
-//   add       x' = x + t · value
-//   multiply  x' = x · (1 + t (value - 1))
-//   smooth    x' = x + t (avg - x),   avg = mean of the 3x3x3 neighbourhood, read before the dab
-//   erase     x' = x + t (base - x)
-// with x' = target / avg / base exactly when t = 1 (set, smooth, erase). Arithmetic is in
-// double; the result is stored as float.
-//
-// Channels: sigma_t (σt, RGB), sigma_s (σs, RGB), g; Colour (the artist's form: surface
-// colour, scatter distance and g, volume/material/artist_params.h) drives σt, σs and g with the
-// targets artistToPhysical gives behind the target's boundary index; albedo_mfp drives σt
-// and σs with the targets σt = 1 / mean_free_path, σs = albedo · σt; preset drives σt, σs
-// (Jensen 2001, valid with g = 0) and g (target 0); All (smooth, erase only) drives σt, σs
-// and g. Colour, albedo_mfp and preset take mode set only; add and multiply need sigma_t,
-// sigma_s or g.
-// σ values (targets, add values) are per scene unit like the scene's base material and are
-// converted to the set's units; radius and depth are world lengths.
-//
-// Validity (after every voxel write, in this order): σt clamped to [0, FLT_MAX]; σs clamped
-// to [0, σt] per channel (σs is clamped, not scaled: painting σt alone changes the albedo,
-// albedo_mfp is the control that keeps it); g clamped to [-0.99, 0.99]. Inputs are
-// finite, so no NaN or Inf can arise.
-//
-// Strokes. A stroke is a world-space polyline of points or a list of rays hitting the
-// surface. Dabs sit at the points and along each segment at a spacing of at most
-// radius / 4 (segment of length L: ceil(4L / radius) equal steps; a point equal to the
-// previous one adds none), and are applied one after another (overlapping dabs build up
-// like an airbrush's flow). Rays are intersected
-// with the object's world mesh; between two consecutive hits the rays are interpolated
-// (origins linearly, directions linearly then normalized) and re-intersected, halving up
-// to 12 times, until neighbouring hits are at most radius / 4 apart, so the stroke follows
-// the surface. A ray that misses ends the current path (no fill across it). With depth
-// d > 0 each surface dab becomes a column of dabs from the hit to hit - d·n (n the outward
-// normal), at a spacing of at most radius / 4.
-//
-// Mirror. With a mirror the dab at c and its reflection c' across the rest-space plane
-// (axis x|y|z, at = coordinate, default the centre of the object's rest bounds) are applied
-// as one dab with w = falloff(min(|p - c|, |p - c'|) / radius_rest). When the grid's index
-// axes are the rest axes (any scale + translation) the plane snaps to the nearest multiple
-// of half a voxel (see mirrorPlane()) and v's mirror voxel is found by index, so the
-// result is exactly symmetric; for rotated grid transforms the reflection is geometric.
-//
-// History. Each stroke records, for exactly the voxels it wrote, the stored values and
-// active states before and after (76 bytes a voxel); undo writes back "before", redo
-// "after", so both are bit-identical. Unbounded; memory grows with touched voxels only.
-// A new stroke after an undo drops the strokes that could have been redone.
+// Space, per-voxel material, the dab arithmetic, channels, validity, strokes, mirror and
+// history: docs/design.md §4.1.
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 #include <memory>

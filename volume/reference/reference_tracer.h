@@ -1,37 +1,9 @@
 #pragma once
 // Ground truth for SSLPV: a Monte Carlo volumetric path tracer over exactly the scene
-// `sslpv render` reads (docs/design.md §7). Delta tracking (free flights) and residual ratio
-// tracking (shadow rays) with a majorant and a minorant per brick and channel
-// (volume/reference/majorant_grid.h), exact exp(-σt·length) and no field lookups in bricks the
-// material set does not reach, Henyey–Greenstein phase
-// with the local g, RGB traced one channel at a time, a smooth dielectric boundary
-// (ior 1 = invisible boundary) and next-event estimation to point, spot and directional
-// lights.
-//
-// Connections to lights through the boundary (ior != 1): lights are delta lights outside
-// the object, so a path vertex inside can reach them only through the refracting
-// boundary, and that connection is itself a delta event. When the mesh's triangles lie in
-// at most 64 planes (a box, any flat-faced solid), each face's refracted path is found
-// exactly (volume/reference/refracted_connection.h): the refracting point, the ray tube's
-// compression, the Fresnel transmittance at the outside angle, the attenuation along the
-// refracted segment; the face must be the first boundary from the vertex and the light
-// visible from the refracting point. Light that reaches a vertex after specular
-// reflections inside without scattering in between is followed through up to two
-// reflections (one for meshes of 7 to 16 planes, none beyond): it is not negligible even
-// for thick objects, since next to an edge the light refracted in through one face is
-// totally reflected by the other (a box furnace at η 1.4 lost 1.9 % at a face centre and
-// 8.8 % near two edges without it). Longer unscattered paths are missed (they cross the
-// object: negligible for objects many mean free paths thick, not for thin ones: a box
-// 2 mean free paths across is still 14 % dark). The reflected connections are many
-// (6·5^m per light and vertex on a box) and are Russian-rouletted against a bound of their
-// transmittance; they still make next-event estimation on a box several times dearer.
-// Curved meshes are connected the same way through their faces (FacetedBoundary): the
-// geometry the camera paths see, whose normals are the flat triangles' own; a walk finds
-// the face the light's path leaves through and a search around it the faces whose beams
-// overlap there (internal reflections are not followed: a curved object's chords are
-// long). Until 2026-11-30 they used the straight line to the light with the Fresnel
-// transmittance at the crossing: a white furnace in a unit sphere at ior 1.4 returned
-// 75 % of the right radiance at σt = 0.5 and 88 % at σt = 2.
+// `sslpv render` reads. Delta tracking with per-brick majorants, residual ratio tracking
+// for shadow rays, Henyey-Greenstein with the local g, a smooth dielectric boundary and
+// next-event estimation through it along the refracted path (exact per flat face, faceted
+// for curved meshes). Method, connections and what it misses: docs/design.md §7.
 #include <cstdint>
 #include <functional>
 #include <glm/vec3.hpp>
