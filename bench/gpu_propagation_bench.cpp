@@ -53,6 +53,7 @@
 #include "shaders/spirv_library.h"
 #include "device_shared/lpv_constants.h"
 #include "volume/lpv/lpv_stages.h"
+#include "volume/cpu/propagate.h"
 
 namespace {
 using namespace sslpv;

@@ -10,6 +10,7 @@
 
 #include "lpv_test_grids.h"
 #include "volume/calibration/lpv_calibration.h"
+#include "volume/cpu/propagate.h"
 
 namespace {
 using namespace sslpv;

@@ -15,6 +15,8 @@
 #include "volume/core/fresnel.h"
 #include "volume/calibration/lpv_calibration.h"
 #include "volume/lpv/lpv_stages.h"
+#include "volume/cpu/inject.h"
+#include "volume/cpu/propagate.h"
 
 namespace sslpv::test {
 namespace {

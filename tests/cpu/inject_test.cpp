@@ -7,6 +7,7 @@
 
 #include "volume/calibration/lpv_calibration.h"
 #include "volume/lpv/sh.h"
+#include "volume/cpu/inject.h"
 
 namespace {
 using namespace sslpv;

@@ -12,6 +12,7 @@
 #include "volume/calibration/lpv_calibration.h"
 #include "volume/scene/mesh.h"
 #include "volume/lpv/sh.h"
+#include "volume/cpu/propagate.h"
 
 namespace {
 using namespace sslpv;

@@ -23,6 +23,9 @@
 #include "volume/material/scene_object.h"
 #include "volume/lpv/voxelize_parity.h"
 #include "volume/lpv/resample.h"
+#include "volume/cpu/shadow_map.h"
+#include "volume/cpu/inject.h"
+#include "volume/cpu/propagate.h"
 
 namespace sslpv::test {
 namespace {

@@ -8,6 +8,7 @@
 #include "volume/core/fresnel.h"
 #include "volume/lpv/lpv_stages.h"
 #include "volume/scene/ray_scene.h"
+#include "volume/cpu/shadow_map.h"
 
 namespace {
 using namespace sslpv;

@@ -16,6 +16,7 @@
 #include "volume/eval/image_metrics.h"
 #include "volume/material/material_set.h"
 #include "volume/scene/scene.h"
+#include "volume/cpu/propagate.h"
 
 namespace {
 using namespace sslpv;

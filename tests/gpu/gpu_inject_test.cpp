@@ -31,6 +31,7 @@
 #include "test_meshes.h"
 #include "volume/lpv/sh.h"
 #include "volume/lpv/voxelize.h"
+#include "volume/cpu/inject.h"
 
 namespace {
 using namespace sslpv;

@@ -19,6 +19,7 @@
 #include "lpv_test_grids.h"
 #include "seeded_draws.h"
 #include "volume/core/error.h"
+#include "volume/cpu/propagate.h"
 
 namespace {
 using namespace sslpv;

@@ -52,6 +52,10 @@
 #include "volume/scene/ray_scene.h"
 #include "volume/scene/shadow_view.h"
 #include "volume/lpv/voxelize.h"
+#include "volume/cpu/shadow_map.h"
+#include "volume/cpu/inject.h"
+#include "volume/cpu/propagate.h"
+#include "volume/cpu/shade.h"
 
 namespace {
 using namespace sslpv;

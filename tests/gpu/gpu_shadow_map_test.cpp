@@ -54,6 +54,7 @@
 #include "test_meshes.h"
 #include "volume/core/fresnel.h"
 #include "volume/scene/ray_scene.h"
+#include "volume/cpu/shadow_map.h"
 
 namespace {
 using namespace sslpv;

@@ -10,6 +10,8 @@
 #include "volume/material/scene_object.h"
 #include "volume/lpv/voxelize_parity.h"
 #include "volume/lpv/resample.h"
+#include "volume/cpu/inject.h"
+#include "volume/cpu/propagate.h"
 
 namespace sslpv {
 

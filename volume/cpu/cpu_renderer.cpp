@@ -13,6 +13,10 @@
 #include "volume/cpu/single_scattering.h"
 #include "volume/lpv/voxelize_parity.h"
 #include "volume/lpv/resample.h"
+#include "volume/cpu/shadow_map.h"
+#include "volume/cpu/inject.h"
+#include "volume/cpu/propagate.h"
+#include "volume/cpu/shade.h"
 
 namespace sslpv {
 namespace {

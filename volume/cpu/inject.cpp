@@ -1,5 +1,7 @@
 // Injection: refracted flux enters the LPV as clamped-cosine L1 lobes (seed scheme) or as
 // isotropic sources at the medium's depth (calibrated), docs/design.md §6.2 "Injection".
+#include "volume/cpu/inject.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>

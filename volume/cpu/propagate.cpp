@@ -5,6 +5,8 @@
 // One file past the usual ~600 lines on purpose: the gather kernels are inline templates
 // instantiated by the step loops below, and keeping both in one translation unit is what
 // lets the compiler inline and vectorize them without exporting the kernels in a header.
+#include "volume/cpu/propagate.h"
+
 #include <pmmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

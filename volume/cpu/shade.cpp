@@ -1,4 +1,6 @@
 // Shading: the camera sees the surface; radiance comes from the LPV just inside it.
+#include "volume/cpu/shade.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -16,6 +18,7 @@
 #include "volume/cpu/shading_surface.h"
 #include "volume/cpu/single_scattering.h"
 #include "volume/scene/camera_rays.h"
+#include "volume/cpu/inject.h"
 
 namespace sslpv {
 namespace {

@@ -1,5 +1,7 @@
 // Shadow maps on the CPU: one ray per texel from the light, refracted flux per hit. The
 // views (and so the texel rays) are planned by planShadowViews, shared with the GPU twin.
+#include "volume/cpu/shadow_map.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 

@@ -9,6 +9,7 @@
 
 #include "device_shared/lpv_constants.h"
 #include "volume/lpv/lpv_stages.h"
+#include "volume/cpu/inject.h"
 
 namespace sslpv {
 namespace {

@@ -1,7 +1,8 @@
 #pragma once
-// The stages of one SSLPV frame on the CPU (Børlum et al. 2011): light samples from a
-// shadow map per light, injection as clamped-cosine L1 SH lobes, propagation with
-// extinction and scattering, and shading. This is the reference the GPU backend matches.
+// The data of one SSLPV frame's stages (Børlum et al. 2011) that both backends share:
+// shadow-map samples, injection and propagation options and results, the per-cell step
+// factors. The CPU stages themselves are volume/cpu/{shadow_map,inject,propagate,shade}.h;
+// the GPU's are gpu/passes/.
 #include <array>
 #include <glm/vec3.hpp>
 #include <vector>
@@ -33,24 +34,6 @@ struct ShadowMapStats {
   bool culled = false;           ///< the light cannot reach the object
 };
 
-/// Casts a size x size shadow map of `light` over the object (`bounds`) and returns one
-/// sample per texel that hits it, flux already multiplied by the Fresnel transmittance
-/// for relative index `ior`. Point and spot lights use a perspective map aimed at the
-/// object (a cube map when the light is inside its bounding sphere); directional lights
-/// an orthographic map. Lights that cannot reach the object return nothing (culled).
-/// With `entries`, also appends each view's every texel as the single-scattering term
-/// reads it (volume/cpu/single_scattering.h), tagged `lightIndex`.
-std::vector<SurfaceFluxSample> castShadowMap(const Light& light, const RayScene& rays,
-                                             const Bounds& bounds, int size, double ior,
-                                             ShadowMapStats* stats = nullptr,
-                                             std::vector<EntryMap>* entries = nullptr, int lightIndex = 0);
-
-/// Trilinear weights of the 8 cells around world point p (continuous cell coordinates,
-/// cell centres at half-integers) times each cell's coverage, restricted to active cells and
-/// renormalized. Returns the number of cells used (0: no active cell nearby).
-int activeTrilinearWeights(const MaterialGrid& material, const glm::dvec3& p,
-                           std::size_t cells[8], float weights[8]);
-
 struct StepFactors;
 
 struct InjectionStats {
@@ -59,18 +42,6 @@ struct InjectionStats {
   glm::dvec3 injectedFlux{0.0};
   glm::dvec3 droppedFlux{0.0};   ///< flux of samples with no active cell nearby
 };
-
-/// Seed scheme (`calibrated` null): adds each sample as a clamped cosine lobe about its
-/// refracted direction, holding flux/π, half a cell inside the surface, spread
-/// trilinearly over active cells. Calibrated scheme (`calibrated` holds its step factors):
-/// per channel, an isotropic source of the sample's flux times the oblique-entry gain at
-/// depth max(injectionDepth cos θt, Δx / 2) along the inward normal, injectionDepth and
-/// the gain's nodes read from the cell half a cell inside (lpv_calibration.h), θt the
-/// refracted direction's angle to the normal. Either way a sample that finds no active cell
-/// there looks a cell deeper (Δx / 2 further) before it is dropped.
-InjectionStats injectSamples(const std::vector<SurfaceFluxSample>& samples,
-                             const MaterialGrid& material, ShGrid& grid,
-                             const StepFactors* calibrated = nullptr);
 
 /// Per-step power bookkeeping. Every quantity is total flux (W), per channel.
 struct StepEnergy {
@@ -147,17 +118,6 @@ struct PropagationOptions {
   /// mean cell's, of that floor). A cold run's worst cell is about as far off.
   double warmLocalTolerance = 1e-2;
 };
-
-/// The Chebyshev semi-iteration's weight for iterate k + 1 (k ≥ 1; iterate 1 has weight
-/// 1) when the step operator's eigenvalues lie in [-rho, rho]:
-/// ω = 2 / (1 + tanh(k acosh(1/rho)) sqrt(1 - rho²)), the closed form of the three-term
-/// recurrence ω_{k+1} = 1 / (1 - rho² ω_k / 4). Both backends take it from here.
-double chebyshevOmega(int k, double rho);
-
-/// The factor by which the semi-iteration's error shrinks per step in the limit,
-/// rho / (1 + sqrt(1 - rho²)); its --steps auto rule extrapolates the rest with it (or
-/// with the shrink it observes, where that is slower).
-double chebyshevRate(double rho);
 
 struct PropagationResult {
   int stepsRun = 0;
@@ -259,36 +219,5 @@ inline bool propagationSteps(const GridFrame& frame, const PropagationOptions& o
 /// (StepFactors::freshGain; empty: 1). The start of a propagation that runs steps; with
 /// no step the injected light is added as is (GpuPropagator starts the same way).
 void addInjected(const std::array<std::vector<float>, 3>& freshGain, const ShGrid& injected, ShGrid& accumulated);
-
-/// Flux a cell with coefficients (c0, cx, cy, cz) sends through the 5 faces of each of
-/// its 6 neighbours (order -x, +x, -y, +y, -z, +z), clamped as the propagation clamps.
-std::array<float, 6> neighbourFaceFlux(float c0, float cx, float cy, float cz);
-
-/// Propagates `field` (the injected light, replaced by the last step's light) for the
-/// requested steps and adds every step, including the injected one, into `accumulated`
-/// (with auto steps, also the estimated tail of the steps not run).
-/// Each step gathers flux from the 6 neighbours through 5 faces of each destination
-/// (exact face solid angles), re-emits it as cosine lobes, then applies extinction and
-/// scattering. The max(0,·) clamp of the face evaluation is renormalized per source cell
-/// so a step never emits more power than the cell holds.
-PropagationResult propagate(const MaterialGrid& material, const StepFactors& factors,
-                            ShGrid& field, ShGrid& accumulated, const PropagationOptions& options);
-
-/// Rasterizes the object from the camera by ray casting; each pixel reads the accumulated
-/// LPV half a cell inside the surface, converts intensity to exitant radiance through the
-/// hemisphere integral, and applies the exit Fresnel transmittance (and the 1/η² radiance
-/// change across the boundary). Background pixels are 0.
-/// `exitGain` (StepFactors::exitGain) scales each cell's coefficients; null = 1.
-/// `reducedAlbedo` (StepFactors::reducedAlbedo): with it (non-null, non-empty) each cell's
-/// radiance also follows its medium's exit angular shape, exitLawShape(exitLawTable(ior),
-/// α', cos θo), which keeps each cell's total exitant power; null or empty: Lambertian
-/// inside the boundary.
-/// `singleScattering`: the shadow maps' entry texels; with them the calibrated
-/// single-scattering term is added.
-Image shadeImage(const Camera& camera, const RayScene& rays, const MaterialGrid& material,
-                 const ShGrid& accumulated, double ior,
-                 const std::array<std::vector<float>, 3>* exitGain = nullptr,
-                 const std::array<std::vector<float>, 3>* reducedAlbedo = nullptr,
-                 const std::vector<EntryMap>* singleScattering = nullptr);
 
 }  // namespace sslpv
