@@ -18,8 +18,7 @@
 #include "volume/material/material_set.h"
 #include "volume/scene/scene.h"
 #ifdef SSLPV_HAVE_VULKAN
-#include "gpu/vk/device.h"
-#include "gpu/vk/vk_check.h"
+#include "gpu_test_fixture.h"
 #endif
 
 namespace sslpv {
@@ -53,15 +52,8 @@ class FrameCache : public ::testing::TestWithParam<BackendKind> {
       return;
     }
 #ifdef SSLPV_HAVE_VULKAN
-    try {
-      gpu::DeviceOptions options;
-      options.validation = true;
-      device_ = std::make_unique<gpu::VulkanDevice>(options);
-    } catch (const NoVulkanDeviceError& e) {
-      GTEST_SKIP() << "SKIPPED, no Vulkan device on this machine: " << e.what();
-    }
-    log_ = device_->validationLog();
-    backends_ = std::make_unique<Backends>(BackendKind::Vulkan, *device_);
+    if (!device_.open()) GTEST_SKIP() << device_.skipReason();
+    backends_ = std::make_unique<Backends>(BackendKind::Vulkan, device_.device());
 #else
     GTEST_SKIP() << "SKIPPED, this build has no Vulkan backend";
 #endif
@@ -70,10 +62,7 @@ class FrameCache : public ::testing::TestWithParam<BackendKind> {
   void TearDown() override {
     backends_.reset();
 #ifdef SSLPV_HAVE_VULKAN
-    device_.reset();
-    if (log_) {
-      EXPECT_EQ(log_->count(), 0u) << "validation messages:\n" << log_->text();
-    }
+    device_.closeAndCheck();
 #endif
   }
 
@@ -105,8 +94,7 @@ class FrameCache : public ::testing::TestWithParam<BackendKind> {
 
  private:
 #ifdef SSLPV_HAVE_VULKAN
-  std::unique_ptr<gpu::VulkanDevice> device_;
-  std::shared_ptr<const gpu::ValidationLog> log_;
+  test::ValidatedDevice device_;
 #endif
   std::unique_ptr<Backends> backends_;
 };
