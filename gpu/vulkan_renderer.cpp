@@ -9,6 +9,7 @@
 #include "gpu/passes/gpu_shade.h"
 #include "gpu/passes/gpu_shadow_map.h"
 #include "gpu/passes/gpu_voxelize.h"
+#include "gpu/passes/gpu_mesh.h"
 #include "gpu/vk/graphics.h"
 #include "volume/material/material_set.h"
 #include "volume/lpv/resample.h"

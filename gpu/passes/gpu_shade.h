@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "gpu/vk/compute.h"
+#include "gpu/passes/gpu_mesh.h"
 #include "gpu/vk/graphics.h"
 #include "device_shared/shade_shared.h"
 #include "volume/calibration/exit_law.h"

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gpu/vk/compute.h"
+#include "gpu/passes/gpu_mesh.h"
 #include "gpu/vk/graphics.h"
 #include "device_shared/flux_sample_shared.h"
 #include "device_shared/shadow_map_shared.h"
