@@ -42,8 +42,9 @@ namespace sslpv::gpu {
 /// The calibrated scheme's per-cell injection record (binding 4 of shaders/lpv_inject.comp,
 /// built by sslpv::gpu::uploadCalibratedInjection), x-fastest, this many vec4 per cell:
 /// (injection depth rgb, ior²), then per channel r, g, b a vec4 of the oblique-entry gain
-/// at its SSLPV_OBLIQUE_INTERVALS nodes (StepFactors::obliqueGain).
-#define SSLPV_CALIBRATED_INJECTION_VEC4 4
+/// at its SSLPV_OBLIQUE_INTERVALS nodes (StepFactors::obliqueGain), then (entry coupling
+/// rgb, unused) (StepFactors::entryCoupling).
+#define SSLPV_CALIBRATED_INJECTION_VEC4 5
 
 /// Push constants of shaders/lpv_inject.comp.
 #define SSLPV_INJECT_PUSH_FIELDS(X) \

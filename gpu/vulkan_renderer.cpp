@@ -30,7 +30,7 @@ double msSince(std::chrono::steady_clock::time_point start) {
 /// grid's (sphere, --steps auto, lavapipe): 667 B a cell at 64^3.
 std::size_t vulkanLpvBytes(const GridFrame& frame) {
   constexpr std::size_t kFloat = sizeof(float), kVec4 = 4 * kFloat;
-  constexpr std::size_t host = kFloat * (1 + 3 + 3 + 1) + kFloat * (8 * 3 + 3 * SSLPV_OBLIQUE_INTERVALS) + 1;
+  constexpr std::size_t host = kFloat * (1 + 3 + 3 + 1) + kFloat * (9 * 3 + 3 * SSLPV_OBLIQUE_INTERVALS) + 1;
   constexpr std::size_t device = 2 * kFloat + kFloat + 8 * kFloat + 2 * kVec4 + SSLPV_CALIBRATED_INJECTION_VEC4 * kVec4 +
                                  SSLPV_FACTOR_VEC4_PER_CELL * kVec4;
   return frame.cellCount() * (host + device) + 5 * std::size_t(lightFieldBytes(frame));

@@ -28,9 +28,9 @@ layout(std430, binding = 0) readonly buffer Samples { GpuFluxSample samples[]; }
 // c1y, c1z), as 12 floats so that each coefficient can be added atomically.
 layout(std430, binding = 2) buffer Field { float field[]; };
 layout(std430, binding = 3) writeonly buffer Stats { vec4 partials[]; };
-// Per cell, x-fastest, SSLPV_CALIBRATED_INJECTION_VEC4 vec4: (injection depth rgb, ior²)
-// and the oblique-entry gain nodes of r, g and b (cell_coverage_shared.h); unread in the
-// seed scheme.
+// Per cell, x-fastest, SSLPV_CALIBRATED_INJECTION_VEC4 vec4: (injection depth rgb, ior²),
+// the oblique-entry gain nodes of r, g and b and the entry coupling rgb
+// (cell_coverage_shared.h); unread in the seed scheme.
 layout(std430, binding = 4) readonly buffer Calibration { vec4 calibration[]; };
 
 // sslpv::obliqueEntryGain: piecewise linear in y = cos² θi over nodes at
@@ -100,7 +100,7 @@ void main() {
           deepWeights = weights;
         }
         // Isotropic with power Φ: the c0 of a cosine lobe of power Φ, no linear band.
-        const float gain = obliqueEntryGain(calibration[record + 1u + uint(ch)], incidence);
+        const float gain = obliqueEntryGain(calibration[record + 1u + uint(ch)], incidence) * calibration[record + 4u][ch];
         const float c0 = float(SSLPV_COSINE_LOBE_C0) * gain * rec.flux[ch] / float(SSLPV_PI);
         for (int i = 0; i < deepUsed; ++i) atomicAdd(field[12u * deepCells[i] + 4u * uint(ch)], deepWeights[i] * c0);
       }

@@ -120,6 +120,12 @@ struct WideSlab {
     const int c = material.frame.dims.x / 2;
     return accumulated.plane(channel, 0)[material.frame.index(c, c, z)] * SSLPV_FLUX_PER_C0;
   }
+  /// The power injected per unit power entering (StepFactors::entryCoupling, the same in
+  /// every cell of the uniform slab).
+  double entryCoupling(int channel = 0) const {
+    const int c = material.frame.dims.x / 2;
+    return factors.entryCoupling[channel][material.frame.index(c, c, top)];
+  }
 };
 
 WideSlab litWideSlab(const Medium& medium, double cellSize, double ior, const glm::vec3& refracted) {
@@ -173,8 +179,8 @@ TEST(LpvCalibration, SurvivalAndRetentionGiveTheClosedFormLattice) {
     for (int z = top - 2; z >= top - 9; --z)
       EXPECT_NEAR(power(z - 1) / power(z), r, 5e-4 * r) << "ior " << ior << " layer " << z;
     // The closed form the exit gain is built on: the top layer accumulates 2 R_lpv times
-    // the power injected per column.
-    const double expected = 2.0 * latticeReflectance(skin, cellSize, ior);
+    // the power injected per column (the entering power times the entry coupling).
+    const double expected = 2.0 * latticeReflectance(skin, cellSize, ior) * slab.entryCoupling();
     EXPECT_NEAR(power(top), expected, 5e-4 * expected) << "ior " << ior;
   }
 }
@@ -272,8 +278,9 @@ TEST(LpvCalibration, ObliqueEntryGainMakesTheLatticeReflectTheMediumsRdAtEveryAn
     const glm::vec3 refracted(float(std::sqrt(1.0 - cosRefracted * cosRefracted)), 0.0f, -float(cosRefracted));
     const WideSlab slab = litWideSlab(skin, cellSize, ior, refracted);
     // Shading reads the top layer as an isotropic cell: out goes gain · power / 2 · leaving
-    // per entering power (the derivation in lpv_calibration.cpp).
-    const double reflected = gain * 0.5 * slab.columnPower(slab.top) * leaving;
+    // per injected power (the derivation in lpv_calibration.cpp); the injection holds the
+    // entering power times the entry coupling, which shading divides out of the gain.
+    const double reflected = gain * 0.5 * slab.columnPower(slab.top) / slab.entryCoupling() * leaving;
     AddingDoublingOptions options;
     options.beamCosine = cosRefracted;
     const double medium = addingDoublingHalfSpace(skin.albedo(), ior, options).rd /

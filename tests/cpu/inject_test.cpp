@@ -67,8 +67,9 @@ TEST(Injection, CalibratedSchemeInjectsIsotropicSourcesWhereLightScattersTheSeco
   // σt' per channel 0.25, 0.5, 2 per cell: 1/σt' = 4, 2 and 0.5 cells, and light scatters
   // the second time k = secondScatteringDepth(1.3) ≈ 1.22 times that deep (the last is
   // near the Δx / 2 floor). Light entering along the normal is centred that deep below
-  // the top face (z = 15), isotropic, with all its power; entering at 60° to the normal it
-  // starts half as deep (the floor stays), its power times the oblique-entry gain.
+  // the top face (z = 15), isotropic, with its power times the entry coupling (the square
+  // root of the medium's calibrated gain); entering at 60° to the normal it starts half as
+  // deep (the floor stays), its power also times the oblique-entry gain.
   MaterialGrid material =
       uniformMaterial(16, glm::vec3(0.25f, 0.5f, 2.0f), glm::vec3(0.2f, 0.45f, 1.9f), 0.0f);
   const StepFactors factors = computeStepFactors(material, LpvScheme::Calibrated, 1.3);
@@ -93,7 +94,11 @@ TEST(Injection, CalibratedSchemeInjectsIsotropicSourcesWhereLightScattersTheSeco
       if (cosTheta < 1.0) {
         EXPECT_GT(std::abs(gain - 1.0), 0.005) << "channel " << ch;  // so the power check is not vacuous
       }
-      EXPECT_NEAR(channelPower(grid, ch), (ch + 1.0) * gain, 1e-5 * (ch + 1.0));
+      const double coupling = factors.entryCoupling[ch][anyCell];
+      EXPECT_NEAR(coupling * coupling,
+                  calibratedTransport(material.sigmaT[anyCell][ch], material.sigmaS[anyCell][ch], 0.0, 1.0, 1.3).exitGain,
+                  1e-6);
+      EXPECT_NEAR(channelPower(grid, ch), (ch + 1.0) * gain * coupling, 1e-5 * (ch + 1.0));
     }
     EXPECT_EQ(stats.injectedFlux, glm::dvec3(1.0, 2.0, 3.0));
   }
@@ -112,7 +117,7 @@ TEST(Injection, CalibratedSourceDeeperThanTheObjectStaysWhereItEntered) {
   injectSamples({{glm::vec3(4.0f, 4.0f, 3.0f), glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::vec3(1.0f)}}, material,
                 grid, &factors);
   EXPECT_NEAR(meanDepthAndLargestLinear(grid, 0).x, 2.5, 1e-6) << "the top layer (centre z = 2.5)";
-  EXPECT_NEAR(channelPower(grid, 0), 1.0, 1e-6);
+  EXPECT_NEAR(channelPower(grid, 0), factors.entryCoupling[0][material.frame.index(4, 4, 2)], 1e-6);
 }
 
 TEST(Injection, OnlyCellsInsideTheMediumReceiveLight) {

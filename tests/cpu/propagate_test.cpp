@@ -610,7 +610,7 @@ TEST(GridFrame, TooLargeAGridIsAClearResourceError) {
 TEST(ExitGain, HomogeneousCellsKeepTheirCalibratedGain) {
   // Inside a homogeneous medium every neighbour has the same gain, so the neighbourhood
   // limit changes nothing: the calibration (and its tests) stay exact where the surface
-  // runs along the grid. Along the block's edges the surface's normal is diagonal, and the
+  // runs along the grid. The gain is the entry coupling times the exit gain. Along the block's edges the surface's normal is diagonal, and the
   // staircase correction (staircaseExitCorrection, |n|_1 = sqrt 2) applies on top.
   const MaterialGrid m = test::uniformMaterial(6, glm::vec3(3.0f, 5.0f, 9.0f), glm::vec3(1.0f, 1.0f, 1.0f), 0.2f, 0.7);
   const StepFactors f = computeStepFactors(m, LpvScheme::Calibrated, 1.3);
@@ -624,9 +624,11 @@ TEST(ExitGain, HomogeneousCellsKeepTheirCalibratedGain) {
           const std::size_t i = m.frame.index(x, y, z);
           const int outside = (x == 1 || x == 4) + (y == 1 || y == 4) + (z == 1 || z == 4);
           if (outside <= 1) {
-            ASSERT_EQ(f.exitGain[ch][i], own.exitGain) << "cell " << x << y << z << " channel " << ch;
+            ASSERT_NEAR(f.exitGain[ch][i] * f.entryCoupling[ch][i], own.exitGain, 1e-6 * own.exitGain)
+                << "cell " << x << y << z << " channel " << ch;
           } else if (outside == 2) {
-            EXPECT_NEAR(f.exitGain[ch][i], own.exitGain * staircaseExitCorrection(own.freshShare, std::sqrt(2.0)),
+            EXPECT_NEAR(f.exitGain[ch][i] * f.entryCoupling[ch][i],
+                        own.exitGain * staircaseExitCorrection(own.freshShare, std::sqrt(2.0)),
                         1e-5 * own.exitGain)
                 << "cell " << x << y << z << " channel " << ch;
             ++edges;
@@ -646,13 +648,15 @@ const glm::vec3 kDenseSigmaT(8.0f), kDenseSigmaS(7.2f);     // albedo 0.9
 
 /// Cell i's exit gain as the neighbourhood limit left it: painted media differ in σt', so
 /// the lattice also divides each cell's gain by λ = 1 + s (1/w − 1) (docs/design.md
-/// §6.7.7), s its survival at w = 1 and w its conductance².
+/// §6.7.7), s its survival at w = 1 and w its conductance², and the entry took its
+/// coupling off the exit (§6.7.10).
 double gainBeforeConductance(const MaterialGrid& m, const StepFactors& f, int ch, std::size_t i) {
-  if (f.conductance[std::size_t(ch)].empty()) return f.exitGain[std::size_t(ch)][i];
+  const double exitGain = double(f.exitGain[std::size_t(ch)][i]) * f.entryCoupling[std::size_t(ch)][i];
+  if (f.conductance[std::size_t(ch)].empty()) return exitGain;
   const double survival =
       calibratedTransport(m.sigmaT[i][ch], m.sigmaS[i][ch], m.g[i], m.frame.cellSize, f.ior).dc;
   const double w = double(f.conductance[std::size_t(ch)][i]) * f.conductance[std::size_t(ch)][i];
-  return f.exitGain[std::size_t(ch)][i] * (1.0 + survival * (1.0 / w - 1.0));
+  return exitGain * (1.0 + survival * (1.0 / w - 1.0));
 }
 
 TEST(ExitGain, ADenseLessScatteringCellInABrightMediumTakesItsNeighboursGain) {

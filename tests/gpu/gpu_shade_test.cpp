@@ -88,10 +88,11 @@ LitObject lightObject(TriangleMesh mesh, const std::vector<Light>& lights, doubl
   ShGrid field;
   field.resize(frame);
   o.accumulated.resize(frame);
-  injectSamples(samples, o.material, field);
+  // Injected as the renderer does, with the calibrated entry: the exit gain assumes it.
+  o.factors = computeStepFactors(o.material, LpvScheme::Calibrated, ior);
+  injectSamples(samples, o.material, field, &o.factors);
   PropagationOptions options;
   options.steps = 24;
-  o.factors = computeStepFactors(o.material, LpvScheme::Calibrated, ior);
   propagate(o.material, o.factors, field, o.accumulated, options);
   // A homogeneous medium has one gain and one reduced albedo per channel; vary them per
   // cell so a wrong cell or channel index in the GPU's gain or exit-law lookup shows. The

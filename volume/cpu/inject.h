@@ -16,9 +16,10 @@ int activeTrilinearWeights(const MaterialGrid& material, const glm::dvec3& p,
 /// Seed scheme (`calibrated` null): adds each sample as a clamped cosine lobe about its
 /// refracted direction, holding flux/π, half a cell inside the surface, spread
 /// trilinearly over active cells. Calibrated scheme (`calibrated` holds its step factors):
-/// per channel, an isotropic source of the sample's flux times the oblique-entry gain at
-/// depth max(injectionDepth cos θt, Δx / 2) along the inward normal, injectionDepth and
-/// the gain's nodes read from the cell half a cell inside (lpv_calibration.h), θt the
+/// per channel, an isotropic source of the sample's flux times the oblique-entry gain and
+/// the entry coupling at depth max(injectionDepth cos θt, Δx / 2) along the inward normal,
+/// injectionDepth, the gain's nodes and the coupling read from the cell half a cell inside
+/// (lpv_calibration.h, StepFactors::entryCoupling), θt the
 /// refracted direction's angle to the normal. Either way a sample that finds no active cell
 /// there looks a cell deeper (Δx / 2 further) before it is dropped.
 InjectionStats injectSamples(const std::vector<SurfaceFluxSample>& samples,

@@ -85,7 +85,7 @@ std::size_t estimateLpvBytes(const GridFrame& frame) {
   // temporaries are gone by then), in bytes:
   //  - MaterialGrid: coverage 4, sigmaT 12, sigmaS 12, g 4;
   //  - StepFactors (calibrated): dc, linear, exitGain, reducedAlbedo, retention,
-  //    injectionDepth, freshGain and conductance 3 floats each, obliqueGain
+  //    injectionDepth, freshGain, conductance and entryCoupling 3 floats each, obliqueGain
   //    3 x SSLPV_OBLIQUE_INTERVALS floats, active 1;
   //  - ShGrids: the injected light and the accumulated light kept by the renderer, and
   //    propagate()'s working field and next step, kPlanes floats each;
@@ -93,7 +93,7 @@ std::size_t estimateLpvBytes(const GridFrame& frame) {
   // Measured peak RSS less a small grid's (sphere, --steps auto): 371 B a cell at 64^3.
   constexpr std::size_t kFloat = sizeof(float);
   constexpr std::size_t material = kFloat * (1 + 3 + 3 + 1);
-  constexpr std::size_t factors = kFloat * (8 * 3 + 3 * SSLPV_OBLIQUE_INTERVALS) + 1;
+  constexpr std::size_t factors = kFloat * (9 * 3 + 3 * SSLPV_OBLIQUE_INTERVALS) + 1;
   constexpr std::size_t light = 4 * ShGrid::kPlanes * kFloat;
   constexpr std::size_t semiIteration = 3 * 3 * kFloat;
   return frame.cellCount() * (material + factors + light + semiIteration);

@@ -305,6 +305,23 @@ void correctThinObject(const MaterialGrid& material, StepFactors& factors) {
   }
 }
 
+/// The gain calibrated for a half-space of one material makes a path that enters and
+/// leaves through that material right, whichever end carries it. Where the path enters
+/// through one material and leaves through another, the exit-side gain alone gave it the
+/// exit material's gain: a backlit slab under a thin absorbing layer came out at that
+/// layer's gain over the core's (×0.13 in blue), and lit from the other side at the
+/// inverse, while transport (and the lattice, whose propagation is symmetric) gives the
+/// same light both ways round. Half the gain (its square root) goes to the entry, half
+/// stays on the exit; the geometric corrections of the exit reading stay on the exit.
+void splitGainBetweenEntryAndExit(const MaterialGrid& material, StepFactors& factors) {
+  const std::size_t n = material.frame.cellCount();
+  for (int ch = 0; ch < 3; ++ch)
+    for (std::size_t i = 0; i < n; ++i) {
+      const float coupling = factors.entryCoupling[ch][i];
+      if (factors.active[i] && coupling > 0.0f) factors.exitGain[ch][i] /= coupling;
+    }
+}
+
 }  // namespace
 
 StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, double ior) {
@@ -325,6 +342,7 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
       factors.injectionDepth[ch].assign(n, 0.0f);
       factors.obliqueGain[ch].assign(n * kObliqueIntervals, 1.0f);
       factors.freshGain[ch].assign(n, 1.0f);
+      factors.entryCoupling[ch].assign(n, 1.0f);
     }
   }
   factors.active.assign(n, 0);
@@ -349,6 +367,7 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
           factors.linear[ch][i] = t.linear;
           factors.exitGain[ch][i] = t.exitGain;
           if (scheme == LpvScheme::Calibrated) {
+            factors.entryCoupling[ch][i] = std::sqrt(t.exitGain);
             factors.reducedAlbedo[ch][i] = t.reducedAlbedo;
             extrapolation[ch][i] = t.extrapolationLength;
             factors.injectionDepth[ch][i] = t.injectionDepth;
@@ -367,6 +386,7 @@ StepFactors computeStepFactors(const MaterialGrid& material, LpvScheme scheme, d
     std::array<std::vector<float>, 3> conductance = diffusivityConductance(material, factors);
     if (!conductance[0].empty()) applyConductance(material, std::move(conductance), factors);
     if (material.meanChord > 0.0) correctThinObject(material, factors);
+    splitGainBetweenEntryAndExit(material, factors);
   }
   return factors;
 }
