@@ -75,7 +75,7 @@ Buffer uploadCalibratedInjection(const VulkanDevice& device, const StepFactors& 
   const std::size_t cells = frame.cellCount();
   for (int ch = 0; ch < 3; ++ch)
     if (factors.injectionDepth[ch].size() != cells || factors.obliqueGain[ch].size() != cells * kObliqueIntervals ||
-        !(factors.entryCoupling[ch].empty() || factors.entryCoupling[ch].size() == cells))
+        factors.entryCoupling[ch].size() != cells)
       throw GpuError("uploadCalibratedInjection: the step factors hold no calibrated injection for this grid frame");
   constexpr std::size_t kFloats = 4 * SSLPV_CALIBRATED_INJECTION_VEC4;
   std::vector<float> values(cells * kFloats, 0.0f);
@@ -86,7 +86,7 @@ Buffer uploadCalibratedInjection(const VulkanDevice& device, const StepFactors& 
       record[ch] = factors.injectionDepth[ch][i];
       for (int k = 0; k < kObliqueIntervals; ++k)
         record[4 * (1 + ch) + k] = factors.obliqueGain[ch][i * kObliqueIntervals + std::size_t(k)];
-      record[16 + ch] = factors.entryCoupling[ch].empty() ? 1.0f : factors.entryCoupling[ch][i];
+      record[16 + ch] = factors.entryCoupling[ch][i];
     }
     record[3] = iorSquared;
   }

@@ -103,7 +103,7 @@ void place(const SurfaceFluxSample& s, const MaterialGrid& material, const StepF
   for (int ch = 0; ch < 3; ++ch) {
     out.gain[ch] = float(
         obliqueEntryGain(&calibrated->obliqueGain[ch][surfaceCell * std::size_t(kObliqueIntervals)], incidence) *
-        (calibrated->entryCoupling[ch].empty() ? 1.0 : double(calibrated->entryCoupling[ch][surfaceCell])));
+        double(calibrated->entryCoupling[ch][surfaceCell]));
     const double depth = std::max(halfCell, double(calibrated->injectionDepth[ch][surfaceCell]) * cosRefracted);
     int& used = out.deepUsed[ch];
     used = depth == halfCell ? 0 : cellsAtDepth(material, p, n, depth, out.deepCells[ch], out.deepWeights[ch]);

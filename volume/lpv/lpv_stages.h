@@ -177,7 +177,7 @@ struct StepFactors {
   /// `exitGain` is divided by it, so light entering and leaving one material sees the
   /// calibrated gain, and light entering through A and leaving through B sees
   /// sqrt(gain_A · gain_B), the same both ways round (reciprocity; docs/design.md
-  /// §6.7.10). Empty: 1 (and in the seed scheme).
+  /// §6.7.10). Empty in the seed scheme.
   std::array<std::vector<float>, 3> entryCoupling;
   /// The boundary's relative index, which turns a sample's refracted direction back into
   /// its incidence angle for the oblique-entry gain (incidentCosineSquared).

@@ -309,7 +309,7 @@ void correctThinObject(const MaterialGrid& material, StepFactors& factors) {
 /// leaves through that material right, whichever end carries it. Where the path enters
 /// through one material and leaves through another, the exit-side gain alone gave it the
 /// exit material's gain: a backlit slab under a thin absorbing layer came out at that
-/// layer's gain over the core's (×0.13 in blue), and lit from the other side at the
+/// layer's gain over the core's (×0.16 in blue), and lit from the other side at the
 /// inverse, while transport (and the lattice, whose propagation is symmetric) gives the
 /// same light both ways round. Half the gain (its square root) goes to the entry, half
 /// stays on the exit; the geometric corrections of the exit reading stay on the exit.
