@@ -107,4 +107,11 @@ void drawOverlay(std::vector<unsigned char>& rgb, int width, int height, const s
     }
 }
 
+std::vector<unsigned char> noteFrame(int width, int height, const std::vector<std::string>& lines) {
+  // Dark grey, not black: drawOverlay darkens its box, so the text's box stays visible.
+  std::vector<unsigned char> rgb(std::size_t(std::max(0, width)) * std::size_t(std::max(0, height)) * 3, 48);
+  drawOverlay(rgb, width, height, lines);
+  return rgb;
+}
+
 }  // namespace sslpv

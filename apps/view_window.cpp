@@ -66,8 +66,7 @@ struct WindowDeleter {
 /// Made on the render thread: the backend the user chose (backend/backends.h), rendering
 /// on the window's device. Under auto, a Vulkan backend that cannot run here is tried
 /// once; the CPU backend renders from then on.
-RendererFactory makeFactory(const std::string& backend, const gpu::VulkanDevice& device) {
-  auto backends = std::make_shared<Backends>(parseBackendKind(backend), device);
+RendererFactory makeFactory(std::shared_ptr<Backends> backends) {
   return [backends](const Scene& scene) -> std::unique_ptr<Renderer> {
     const bool wasVulkan = backends->usesVulkan();
     std::unique_ptr<Renderer> renderer = backends->make(scene);
@@ -140,6 +139,8 @@ class Viewer {
   void scroll(double steps);
   void key(ViewKey key, bool pressed);
   void redraw() { redraw_ = true; }
+  /// The first frame's note says why it takes long on a Vulkan backend.
+  void firstFrameCompilesPipelines(bool yes) { firstFrameCompiles_ = yes; }
 
  private:
   enum class Drag { None, Camera, Light };
@@ -151,6 +152,8 @@ class Viewer {
   void requestFrame();
   void collectResults();
   void present();
+  /// Before the first frame: a note with the seconds waited, redrawn a few times a second.
+  void presentWaitingNote(Clock::time_point now);
   void applyScript(const ScriptEvent& event);
   void waitForScript(const ScriptEvent& event);
   std::vector<std::string> statusLines() const;
@@ -183,6 +186,8 @@ class Viewer {
   std::deque<Clock::time_point> newFrames_;  ///< when recent new frames were presented (fps)
   bool newFrame_ = false;
   Clock::time_point lastTitle_{};
+  Clock::time_point opened_ = Clock::now(), lastNote_{};
+  bool firstFrameCompiles_ = false;
 
   // --frames statistics.
   int presented_ = 0;
@@ -324,6 +329,17 @@ void Viewer::present() {
   if (presented_ == 0) firstPresent_ = now;
   lastPresent_ = now;
   ++presented_;
+}
+
+void Viewer::presentWaitingNote(Clock::time_point now) {
+  if (width_ <= 0 || height_ <= 0 || now - lastNote_ < std::chrono::milliseconds(200)) return;
+  lastNote_ = now;
+  std::vector<std::string> lines{"PREPARING THE FIRST FRAME " +
+                                 fixed1(std::chrono::duration<double>(now - opened_).count()) + " S"};
+  if (firstFrameCompiles_) lines.push_back("(VULKAN COMPILES ITS PIPELINES ONCE; LATER RUNS READ THE SHADER CACHE)");
+  const gpu::DisplayFrame note{width_, height_, noteFrame(width_, height_, lines)};
+  // Not counted as a presented frame: scripts and --frames count images of the scene.
+  presenter_.present(note, width_, height_);
 }
 
 void Viewer::mouseButton(bool right, bool pressed, double x, double y) {
@@ -478,6 +494,7 @@ int Viewer::run() {
       throw ResourceError("view: a frame took longer than 10 minutes to render");
     collectResults();
     if (framesMode() || redraw_) present();
+    if (!frame_ && !framesMode()) presentWaitingNote(Clock::now());
     if (Clock::now() - lastTitle_ > kTitleInterval) updateTitle();
     if (framesMode() && presented_ >= args_.frames) break;
   }
@@ -565,8 +582,11 @@ int runViewWindow(const ViewArgs& args, ViewSetup setup) {
                         "; `sslpv render` writes images without a window");
   }
   // Declared after the device and presenter, so it stops (and drops its backend) first.
-  RenderWorker worker(makeFactory(args.backend, *device));
+  auto backends = std::make_shared<Backends>(parseBackendKind(args.backend), *device);
+  const bool vulkanFrames = backends->usesVulkan();
+  RenderWorker worker(makeFactory(std::move(backends)));
   Viewer viewer(args, setup, window.get(), *presenter, worker);
+  viewer.firstFrameCompilesPipelines(vulkanFrames);
   installCallbacks(window.get(), &viewer);
   const int code = viewer.run();
   glfwSetWindowUserPointer(window.get(), nullptr);

@@ -5,6 +5,7 @@
 #include <glm/geometric.hpp>
 
 #include "apps/view_controls.h"
+#include "apps/view_overlay.h"
 
 namespace sslpv {
 namespace {
@@ -123,6 +124,37 @@ TEST(ViewControls, TimeControlsDoNothingForAStaticScene) {
   EXPECT_GT(controls.time(), 0.0);
   controls.togglePlay();
   EXPECT_TRUE(controls.tick(0.1));
+}
+
+// Before its first image the window shows how long it has waited; the note must be text
+// on a plain frame, not a black or garbage buffer.
+TEST(ViewOverlay, TheFirstFrameNoteIsWhiteTextOnAPlainDarkFrame) {
+  const int width = 320, height = 120;
+  const std::vector<unsigned char> rgb = noteFrame(width, height, {"PREPARING THE FIRST FRAME 1.5 S"});
+  ASSERT_EQ(rgb.size(), std::size_t(width) * height * 3);
+  int text = 0, box = 0, plain = 0, other = 0, textRight = 0, textBottom = 0;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const unsigned char v = rgb[(std::size_t(y) * width + x) * 3];
+      if (v == 255) {
+        ++text;
+        textRight = std::max(textRight, x);
+        textBottom = std::max(textBottom, y);
+      } else if (v == 48 / 3) {
+        ++box;
+      } else if (v == 48) {
+        ++plain;
+      } else {
+        ++other;
+      }
+    }
+  EXPECT_EQ(other, 0);
+  // 27 glyphs of 5x7 with a few lit pixels each, on one line at the top left.
+  EXPECT_GT(text, 27 * 8);
+  EXPECT_LT(textBottom, 20);
+  EXPECT_GT(textRight, 27 * 5);
+  EXPECT_GT(box, text);
+  EXPECT_GT(plain, width * height / 2);
 }
 
 }  // namespace
