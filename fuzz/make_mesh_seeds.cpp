@@ -1,0 +1,38 @@
+// Writes skinned glTF seeds for mesh_fuzz (first byte: the harness's extension index of
+// "gltf"), made at fuzz time with the writer the tests use rather than committed: a rig
+// with clips, one without a skin, and one whose clip animates a node with no joint.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "volume/scene/gltf_writer.h"
+
+namespace {
+
+void writeSeed(const std::filesystem::path& file, const std::string& gltf) {
+  std::ofstream out(file, std::ios::binary);
+  out << char(4) << gltf;  // mesh_fuzz: kExtensions[4] is "gltf"
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace sslpv;
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s OUTPUT_DIR\n", argv[0]);
+    return 2;
+  }
+  const std::filesystem::path dir = argv[1];
+  std::filesystem::create_directories(dir);
+  GltfRig rig = skinnedBar(2.0, 0.5, 4, 2, 0.2);
+  rig.clips = {{"Bend", {{1, "rotation", {0.0, 1.0}, {gltfRotationZ(0.0), gltfRotationZ(90.0)}},
+                         {0, "translation", {0.0, 0.5}, {glm::dvec4(0.0), glm::dvec4(0.0, 1.0, 0.0, 0.0)}}}},
+               {"Scale", {{1, "scale", {0.0, 2.0}, {glm::dvec4(1.0), glm::dvec4(2.0, 1.0, 1.0, 0.0)}}}}};
+  writeSeed(dir / "skinned_bar.gltf", writeGltf(rig));
+  GltfRig plain = rig;
+  plain.vertexJoints.clear();
+  plain.vertexWeights.clear();
+  writeSeed(dir / "unskinned_bar.gltf", writeGltf(plain));
+  return 0;
+}
