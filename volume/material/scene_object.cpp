@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "volume/core/error.h"
+#include "volume/core/strict_json.h"
 #include "volume/material/material_field.h"
 
 namespace sslpv {
@@ -64,6 +65,15 @@ std::vector<glm::vec3> SceneObject::posedPositions(double t, const std::string& 
   if (skinned_) {
     auto skin = std::make_shared<const SkinPose>(*skinned_, restGrid_, clip_, t);
     std::vector<glm::vec3> positions = skinnedPositions(*skin, file, t);
+    // Zero joint scales or inverse bind matrices squash the mesh flat; left alone, that
+    // surfaced as a grid error naming neither the file nor the key.
+    TriangleMesh posed;
+    posed.positions = positions;
+    posed.triangles = restMesh_.triangles;
+    if (!(std::abs(signedVolume(posed)) > 1e-6 * std::abs(signedVolume(restMesh_))))
+      throw InputError((file.empty() ? std::string() : file + ": ") + "mesh.animation: at t = " + formatNumber(t) +
+                       " the pose of " + restMesh_.name +
+                       " encloses no volume (check its joint scales and inverse bind matrices)");
     if (pose) *pose = std::move(skin);
     return positions;
   }
