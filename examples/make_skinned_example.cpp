@@ -41,13 +41,13 @@ sslpv::GltfRig finger() {
   rig.joints[2].name = "tip";
   sslpv::GltfRig::Clip curl{"Curl", {}};
   for (const auto& [joint, degrees] : {std::pair{1, 40.0}, std::pair{2, 50.0}})
-    curl.channels.push_back({joint, "rotation", {0.0, 1.0, 2.0},
-                             {sslpv::gltfRotationZ(0.0), sslpv::gltfRotationZ(degrees), sslpv::gltfRotationZ(0.0)}});
+    curl.channels.push_back(sslpv::gltfTurnZ(joint, {0.0, 1.0, 2.0}, {0.0, degrees, 0.0}));
   rig.clips = {curl};
   return rig;
 }
 
-/// A pale, denser nail on the upper face of the last 7 mm, in the finger's rest space.
+/// A pale, denser nail on the back (-y) face of the last 7 mm, in the finger's rest space:
+/// the finger curls towards +y, the palm side, so the nail ends up on the outside.
 std::size_t writeNail(const fs::path& file) {
   auto set = std::make_shared<sslpv::MaterialSet>();
   set->sigmaT = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
@@ -61,9 +61,9 @@ std::size_t writeNail(const fs::path& file) {
   auto t = set->sigmaT->getAccessor();
   auto s = set->sigmaS->getAccessor();
   std::size_t voxels = 0;
-  // x 33 to 40.5 mm, y from 2 mm to one voxel past the top face, z within ±3 mm.
+  // x 33 to 40.5 mm, y from one voxel past the back face to -2 mm, z within ±3 mm.
   for (int i = 66; i <= 81; ++i)
-    for (int j = 4; j <= 9; ++j)
+    for (int j = -9; j <= -4; ++j)
       for (int k = -6; k <= 6; ++k) {
         t.setValue(openvdb::Coord(i, j, k), openvdb::Vec3s(4.0f, 4.2f, 4.4f));
         s.setValue(openvdb::Coord(i, j, k), openvdb::Vec3s(3.9f, 4.0f, 4.1f));
@@ -79,11 +79,11 @@ json scene() {
     "mesh": {"path": "skinned_finger.gltf", "animation": "Curl"},
     "material": {"base": {"preset": "skin1"}, "vdb": "skinned_finger_nail.vdb", "ior": 1.4},
     "lights": [
-      {"type": "spot", "position": [-20, 70, 60], "direction": [0.4206, -0.6519, -0.6309], "fov_deg": 45,
+      {"type": "spot", "position": [-20, 70, 60], "direction": [0.4025, -0.6418, -0.6527], "fov_deg": 45,
        "intensity": [16000, 15500, 15000]},
       {"type": "point", "position": [50, 10, -50], "intensity": [5000, 4800, 4500]}
     ],
-    "camera": {"position": [20, 12, 95], "target": [20, 8, 0], "up": [0, 1, 0], "fov_y_deg": 40,
+    "camera": {"position": [17, 12, 80], "target": [17, 11, 0], "up": [0, 1, 0], "fov_y_deg": 40,
                "width": 512, "height": 512},
     "lpv": {"resolution": 32, "steps": "auto", "shadow_map": 256}
   })");

@@ -26,9 +26,15 @@ int main(int argc, char** argv) {
   const std::filesystem::path dir = argv[1];
   std::filesystem::create_directories(dir);
   GltfRig rig = skinnedBar(2.0, 0.5, 4, 2, 0.2);
-  rig.clips = {{"Bend", {{1, "rotation", {0.0, 1.0}, {gltfRotationZ(0.0), gltfRotationZ(90.0)}},
-                         {0, "translation", {0.0, 0.5}, {glm::dvec4(0.0), glm::dvec4(0.0, 1.0, 0.0, 0.0)}}}},
-               {"Scale", {{1, "scale", {0.0, 2.0}, {glm::dvec4(1.0), glm::dvec4(2.0, 1.0, 1.0, 0.0)}}}}};
+  // Key values pushed one by one: GCC 12.2 at -O3 with AVX-512 builds a braced list of
+  // constant dvec4s as copies of the first.
+  const GltfRig::Channel turn = gltfTurnZ(1, {0.0, 1.0}, {0.0, 90.0});
+  GltfRig::Channel move{0, "translation", {0.0, 0.5}, {}}, grow{1, "scale", {0.0, 2.0}, {}};
+  move.values.push_back(glm::dvec4(0.0));
+  move.values.push_back(glm::dvec4(0.0, 1.0, 0.0, 0.0));
+  grow.values.push_back(glm::dvec4(1.0));
+  grow.values.push_back(glm::dvec4(2.0, 1.0, 1.0, 0.0));
+  rig.clips = {{"Bend", {turn, move}}, {"Scale", {grow}}};
   writeSeed(dir / "skinned_bar.gltf", writeGltf(rig));
   GltfRig plain = rig;
   plain.vertexJoints.clear();

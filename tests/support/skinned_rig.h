@@ -16,8 +16,8 @@ inline constexpr double kBarLength = 2.0, kBarWidth = 0.5, kJointSpan = 2.0 / 3.
 /// third towards +y.
 inline GltfRig bendingBarRig() {
   GltfRig rig = skinnedBar(kBarLength, kBarWidth, 40, 3, kBlend);
-  GltfRig::Clip idle{"Idle", {{0, "rotation", {0.0, 1.0}, {gltfRotationZ(0.0), gltfRotationZ(0.0)}}}};
-  GltfRig::Clip bend{"Bend", {{2, "rotation", {0.0, 1.0}, {gltfRotationZ(0.0), gltfRotationZ(90.0)}}}};
+  GltfRig::Clip idle{"Idle", {gltfTurnZ(0, {0.0, 1.0}, {0.0, 0.0})}};
+  GltfRig::Clip bend{"Bend", {gltfTurnZ(2, {0.0, 1.0}, {0.0, 90.0})}};
   rig.clips = {idle, bend};
   return rig;
 }

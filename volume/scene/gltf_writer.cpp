@@ -62,6 +62,15 @@ glm::dvec4 gltfRotationZ(double angleDeg) {
   return {0.0, 0.0, std::sin(half), std::cos(half)};
 }
 
+GltfRig::Channel gltfTurnZ(int joint, const std::vector<double>& times, const std::vector<double>& degrees) {
+  GltfRig::Channel channel;
+  channel.joint = joint;
+  channel.path = "rotation";
+  channel.times = times;
+  for (double d : degrees) channel.values.push_back(gltfRotationZ(d));
+  return channel;
+}
+
 std::string writeGltf(const GltfRig& rig) {
   Builder b;
   glm::vec3 lo(1e30f), hi(-1e30f);

@@ -51,4 +51,9 @@ GltfRig skinnedBar(double length, double width, int segments, int jointCount, do
 /// `angleDeg` about z as a glTF rotation value (x, y, z, w).
 glm::dvec4 gltfRotationZ(double angleDeg);
 
+/// A rotation channel of `joint` about z through `degrees` at `times`. Rigs are built with
+/// this rather than braced lists of dvec4: GCC 12.2 at -O3 with AVX-512 (SSLPV_NATIVE on
+/// an AVX-512 machine) builds a braced list of constant dvec4s as copies of the first.
+GltfRig::Channel gltfTurnZ(int joint, const std::vector<double>& times, const std::vector<double>& degrees);
+
 }  // namespace sslpv
