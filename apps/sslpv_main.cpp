@@ -136,8 +136,8 @@ int runRender(const RenderArgs& args) {
     scene.camera.height = sized.height;
   }
   warnAboutScene(scene);
-  if (scene.deformers.empty() && (args.time || frames.size() > 1))
-    printWarning(args.scene + ": the scene has no \"deformers\": every time renders the same image");
+  if (!scene.animated() && (args.time || frames.size() > 1))
+    printWarning(args.scene + ": the scene has no \"deformers\" or mesh.animation: every time renders the same image");
 
   // One renderer kept across the frames of a sequence, so that each frame re-runs only
   // what the new pose changes.
@@ -277,7 +277,7 @@ int main(int argc, char** argv) {
                          "Propagation coefficients: calibrated (default) or seed (overrides lpv.scheme)");
   renderCmd->add_option("--exposure", render.exposure, "PNG only: multiply radiance before tone mapping");
   renderCmd->add_flag("--timings", render.timings, "Print the per-stage timing table");
-  renderCmd->add_option("--time", render.time, "Pose a deforming scene (its \"deformers\") at this time");
+  renderCmd->add_option("--time", render.time, "Pose a deforming scene (its \"deformers\" or skinned mesh.animation) at this time, in seconds");
   renderCmd->add_option("--frames", render.frames,
                         "Render frames A:B[:STEP] (time = frame / --fps) to -o's %04d-style pattern");
   renderCmd->add_option("--fps", render.fps, "Frames per unit of scene time for --frames (default 24)");
@@ -297,7 +297,7 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--spp", reference.spp, "Samples per pixel")->required();
   referenceCmd->add_option("--exposure", reference.exposure, "PNG only: multiply radiance before tone mapping");
   referenceCmd->add_option("--seed", reference.seed, "Random seed (same seed, same image)");
-  referenceCmd->add_option("--time", reference.time, "Pose a deforming scene (its \"deformers\") at this time");
+  referenceCmd->add_option("--time", reference.time, "Pose a deforming scene (its \"deformers\" or skinned mesh.animation) at this time, in seconds");
   referenceCmd->add_option("--threads", reference.threads, "Worker threads (0: all cores)");
   referenceCmd->add_option("--max-scatter", reference.maxScatter,
                            "End paths after this many scattering events (0: unlimited; 1: single scattering only)");

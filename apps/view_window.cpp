@@ -35,7 +35,7 @@ using Clock = std::chrono::steady_clock;
 // Animation: a scene with deformers plays (the render thread's backend is posed at each new
 // time, keeping its grid and warm light); a static scene's time keys (Space, Left, Right)
 // do nothing.
-bool sceneIsAnimated(const Scene& scene) { return !scene.deformers.empty(); }
+bool sceneIsAnimated(const Scene& scene) { return scene.animated(); }
 
 constexpr auto kPollInterval = std::chrono::milliseconds(500);  // how often the files' mtimes are read
 constexpr auto kTitleInterval = std::chrono::milliseconds(250);

@@ -18,12 +18,14 @@ FUZZ_BUILD="${SSLPV_FUZZ_BUILD:-$SSLPV_ROOT/build-fuzz}"
 
 sslpv_install_packages
 sslpv_configure_sanitized "$FUZZ_BUILD" address,undefined -DSSLPV_FUZZ=ON
-targets=(make_vdb_seeds)
+targets=(make_vdb_seeds make_mesh_seeds)
 for h in "${HARNESSES[@]}"; do targets+=("${h}_fuzz"); done
 cmake --build "$FUZZ_BUILD" -j "$(nproc)" --target "${targets[@]}"
 
 # VDB seeds are binary and OpenVDB-version specific: made here, not committed.
 "$FUZZ_BUILD/fuzz/make_vdb_seeds" "$FUZZ_BUILD/fuzz-seeds/material_set"
+# Skinned glTF seeds (a base64 buffer in JSON), from the writer the tests use.
+"$FUZZ_BUILD/fuzz/make_mesh_seeds" "$FUZZ_BUILD/fuzz-seeds/mesh"
 
 # leak_check_at_exit=0: the VDB and mesh readers parse in a forked child that ends with
 # _exit(), which LSan intercepts to leak-check the whole inherited heap (seconds per input

@@ -42,7 +42,7 @@ struct IndexMap {
   glm::dmat3 linear{1.0};
   glm::dvec3 translation{0.0};
   glm::dmat4 worldToRest{1.0};
-  const DeformationPose* deformation = nullptr;  ///< General only: deformed object -> rest
+  const SpaceDeformation* deformation = nullptr;  ///< General only: deformed object -> rest
   const openvdb::math::Transform* transform = nullptr;
 
   glm::dvec3 toIndex(const glm::dvec3& world) const {
@@ -72,7 +72,7 @@ struct IndexMap {
 };
 
 IndexMap makeIndexMap(const openvdb::math::Transform& transform, const glm::dmat4& worldToRest,
-                      const DeformationPose* deformation) {
+                      const SpaceDeformation* deformation) {
   IndexMap map;
   map.worldToRest = worldToRest;
   map.transform = &transform;
@@ -243,7 +243,7 @@ struct FieldChannel {
 
 struct MaterialField::Prepared {
   std::shared_ptr<const MaterialSet> set;  ///< keeps the trees alive
-  std::shared_ptr<const DeformationPose> deformation;  ///< keeps the channels' maps' pose alive
+  std::shared_ptr<const SpaceDeformation> deformation;  ///< keeps the channels' maps' pose alive
   FieldChannel<openvdb::Vec3STree> sigmaT, sigmaS;
   FieldChannel<openvdb::FloatTree> g;
 };
@@ -252,7 +252,7 @@ namespace {
 
 template <class GridT>
 FieldChannel<typename GridT::TreeType> prepareChannel(const typename GridT::Ptr& grid, const glm::dmat4& worldToRest,
-                                                      const DeformationPose* deformation, double scale,
+                                                      const SpaceDeformation* deformation, double scale,
                                                       const typename Channel<typename GridT::TreeType>::Sum& base) {
   FieldChannel<typename GridT::TreeType> channel;
   channel.scale = scale;
@@ -270,7 +270,7 @@ FieldChannel<typename GridT::TreeType> prepareChannel(const typename GridT::Ptr&
 
 MaterialField::MaterialField(const MaterialSample& base, std::shared_ptr<const MaterialSet> set,
                              const glm::dmat4& worldToRest, double sigmaScale,
-                             std::shared_ptr<const DeformationPose> deformation)
+                             std::shared_ptr<const SpaceDeformation> deformation)
     : base_(base),
       set_(std::move(set)),
       worldToRest_(worldToRest),
@@ -282,7 +282,7 @@ MaterialField::MaterialField(const MaterialSample& base, std::shared_ptr<const M
   auto prepared = std::make_shared<Prepared>();
   prepared->set = set_;
   prepared->deformation = deformation_;
-  const DeformationPose* pose = deformation_.get();
+  const SpaceDeformation* pose = deformation_.get();
   prepared->sigmaT =
       prepareChannel<openvdb::Vec3SGrid>(set_->sigmaT, worldToRest_, pose, sigmaScale_, glm::dvec3(base_.sigmaT));
   prepared->sigmaS =

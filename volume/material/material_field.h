@@ -23,7 +23,7 @@ class MaterialField {
  public:
   MaterialField(const MaterialSample& base, std::shared_ptr<const MaterialSet> set,
                 const glm::dmat4& worldToRest, double sigmaScale,
-                std::shared_ptr<const DeformationPose> deformation = nullptr);
+                std::shared_ptr<const SpaceDeformation> deformation = nullptr);
 
   /// Holds ValueAccessors and scratch buffers: cheap to create (one allocation, no tree
   /// traversal), one per thread. Copies share that state: do not use a Sampler and its
@@ -45,8 +45,8 @@ class MaterialField {
   Sampler sampler() const;
   const MaterialSample& base() const { return base_; }
   bool homogeneous() const { return !set_; }
-  /// Painted and posed by deformers: every sample goes back to rest space through their
-  /// inverse.
+  /// Painted and posed (deformers or a skinned clip): every sample goes back to rest space
+  /// through the pose's inverse.
   bool deformed() const { return set_ && deformation_; }
 
  private:
@@ -54,7 +54,7 @@ class MaterialField {
   std::shared_ptr<const MaterialSet> set_;
   glm::dmat4 worldToRest_;
   double sigmaScale_;
-  std::shared_ptr<const DeformationPose> deformation_;
+  std::shared_ptr<const SpaceDeformation> deformation_;
   /// Per-grid maps from world to index space and active bounding boxes, computed once
   /// here so that making a Sampler costs no tree traversal.
   struct Prepared;

@@ -67,13 +67,24 @@ struct PosedDeformer {
   std::string outsideDomain(const glm::dvec3& rest) const;
 };
 
+/// A posed object's map between its rest space, where the material set lives, and its
+/// deformed space: what the material field and the resampling need, whether the pose
+/// comes from procedural deformers or from a skinned clip (volume/scene/skin.h).
+class SpaceDeformation {
+ public:
+  virtual ~SpaceDeformation() = default;
+  virtual glm::dvec3 forward(const glm::dvec3& rest) const = 0;
+  /// NaN components where a point has no rest-space point (the field then reads the base).
+  virtual glm::dvec3 inverse(const glm::dvec3& deformed) const = 0;
+};
+
 /// The whole stack at one time.
-class DeformationPose {
+class DeformationPose : public SpaceDeformation {
  public:
   DeformationPose() = default;
   DeformationPose(const std::vector<Deformer>& deformers, double t);
-  glm::dvec3 forward(const glm::dvec3& rest) const;
-  glm::dvec3 inverse(const glm::dvec3& deformed) const;
+  glm::dvec3 forward(const glm::dvec3& rest) const override;
+  glm::dvec3 inverse(const glm::dvec3& deformed) const override;
   const std::vector<PosedDeformer>& stages() const { return stages_; }
 
  private:

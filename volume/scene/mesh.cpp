@@ -28,6 +28,7 @@
 #include "volume/core/input_file.h"
 #include "volume/core/input_ranges.h"
 #include "volume/core/isolated_child.h"
+#include "volume/scene/mesh_import.h"
 
 namespace sslpv {
 namespace {
@@ -169,10 +170,11 @@ TriangleMesh makeSphere(const MeshSource& source) {
   return mesh;
 }
 
-/// Merges vertices at bit-identical positions. Importers split vertices at normal and UV
-/// seams (and STL stores every triangle's corners separately), which would make a closed
-/// surface look full of holes.
-void weldExactDuplicates(TriangleMesh& mesh) {
+}  // namespace
+
+/// Importers split vertices at normal and UV seams (and STL stores every triangle's
+/// corners separately), which would make a closed surface look full of holes.
+std::vector<unsigned> weldExactDuplicates(TriangleMesh& mesh) {
   struct KeyHash {
     std::size_t operator()(const std::array<std::uint32_t, 3>& k) const {
       std::uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
@@ -201,30 +203,10 @@ void weldExactDuplicates(TriangleMesh& mesh) {
   }
   for (auto& tri : mesh.triangles) tri = glm::uvec3(remap[tri.x], remap[tri.y], remap[tri.z]);
   mesh.positions.swap(welded);
+  return remap;
 }
 
-/// Assimp opens an OBJ's material libraries itself and does not stop at a FIFO or a
-/// device (it blocks in open()), so the `mtllib` files an OBJ names pass the mesh's own
-/// regular-file check first. A missing library stays assimp's business: it goes on
-/// without it, as for any OBJ whose .mtl was not copied along.
-void requireRegularMaterialLibraries(const fs::path& obj) {
-  std::ifstream in(obj, std::ios::binary);
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream words(line);
-    std::string keyword;
-    if (!(words >> keyword) || keyword != "mtllib") continue;
-    // Assimp reads the rest of the line as one file name.
-    std::string name;
-    std::getline(words >> std::ws, name);
-    while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back()))) name.pop_back();
-    if (name.empty()) continue;
-    const fs::path library = obj.parent_path() / name;
-    std::error_code ec;
-    if (fs::exists(library, ec))
-      requireRegularFile(library, ("material library of " + obj.string()).c_str());
-  }
-}
+namespace {
 
 /// The assimp import proper; runs in the reader child (see loadMeshFile).
 TriangleMesh importWithAssimp(const fs::path& path) {
@@ -330,14 +312,7 @@ TriangleMesh decodeChildMesh(const std::string& bytes, const std::string& name) 
 TriangleMesh loadMeshFile(const fs::path& path) {
   const std::string name = path.string();
   std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(name + ": mesh file not found");
-  if (!fs::is_regular_file(path, ec)) throw InputError(name + ": mesh path is not a regular file");
-  requireRegularFile(path, "mesh file");  // a /proc file passes the test above
-  if (!std::ifstream(path, std::ios::binary).good())
-    throw InputError(name + ": cannot read mesh file (" + std::strerror(errno) + ")");
-  std::string extension = path.extension().string();
-  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".obj") requireRegularMaterialLibraries(path);
+  requireReadableMeshFile(path);
 
   static const IsolatedParser kParser{"mesh file", "the assimp importer", "the mesh reader process"};
   const std::size_t bytes = fs::file_size(path, ec);

@@ -124,9 +124,20 @@ MeshSource parseMesh(const SceneReader& in, const json& node) {
   if (file && primitive) in.fail(path, "give either \"path\" or \"primitive\", not both");
   if (!file && !primitive) in.fail(path, "missing required key \"path\" or \"primitive\"");
   if (file) {
-    in.allowOnly(node, path, {"path"});
+    in.allowOnly(node, path, {"path", "animation"});
     mesh.kind = MeshSource::Kind::File;
     mesh.path = in.filePath(*file, childPath(path, "path"));
+    if (const json* animation = in.optional(node, "animation")) {
+      const std::string animationPath = childPath(path, "animation");
+      if (animation->is_number_integer() || animation->is_number_unsigned()) {
+        mesh.animationIndex = in.integer(*animation, animationPath, 0, 1 << 20);
+      } else if (animation->is_string()) {
+        mesh.animationName = in.string(*animation, animationPath);
+        if (mesh.animationName.empty()) in.fail(animationPath, "expected a clip name or index, got an empty string");
+      } else {
+        in.fail(animationPath, "expected a clip name (string) or index (whole number), got " + describeType(*animation));
+      }
+    }
     return mesh;
   }
   std::string kind = in.string(*primitive, childPath(path, "primitive"));
@@ -381,6 +392,10 @@ Scene parseScene(const std::string& jsonText, const fs::path& file) {
     scene.lpv.autoSteps = true;
   }
   if (const json* v = in.optional(root, "deformers")) scene.deformers = parseDeformers(in, *v);
+  // One pose source at a time: the deformers act on rest space, which a skinned clip
+  // already moves; composing the two is not defined yet.
+  if (scene.mesh.animated() && !scene.deformers.empty())
+    in.fail("deformers", "cannot be combined with mesh.animation (a skinned clip); use one or the other");
   return scene;
 }
 

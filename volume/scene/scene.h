@@ -31,6 +31,12 @@ struct MeshSource {
   glm::ivec3 boxSegments{1};
   glm::dvec3 center{0.0};
   double radius = 0.5;
+  /// Kind::File, "animation": the skinned clip to play, by name, or by index when
+  /// animationIndex >= 0 (volume/scene/skin.h). Neither: the file's rest pose, read as
+  /// any mesh file is.
+  std::string animationName;
+  int animationIndex = -1;
+  bool animated() const { return animationIndex >= 0 || !animationName.empty(); }
 };
 
 /// Similarity transform: scale, then rotate (X, then Y, then Z, degrees), then translate.
@@ -87,8 +93,11 @@ struct Scene {
   LpvSettings lpv;
   /// Applied in order to the mesh in rest space, before `transform` (volume/scene/deform.h).
   std::vector<Deformer> deformers;
-  /// The time the deformers are evaluated at (`--time`); unused without deformers.
+  /// The time the deformers or the mesh's clip are evaluated at (`--time`, seconds);
+  /// unused without either.
   double time = 0.0;
+  /// Deformers or a skinned clip: the object's pose depends on `time`.
+  bool animated() const { return !deformers.empty() || mesh.animated(); }
 };
 
 /// `scene` posed at time `t`: every backend that loads it deforms the mesh at `t` and
