@@ -3,8 +3,10 @@
 // screenshot are checked. Skips loudly where the editor was not built (no VTK) or
 // xvfb-run is missing.
 //
-// Window 960x600 (--size): the 3D view covers x 0..480, y 204..600 (VTK's y goes up), the
-// three slice views x 0..320, 320..640, 640..960 at y 30..204 (slices across x, y, z).
+// Views 960x600 (--size; the Qt window's panel, menus and status bar come on top): the 3D
+// view covers x 0..480, y 204..600 (VTK's y goes up), the three slice views x 0..320,
+// 320..640, 640..960 at y 0..204 (slices across x, y, z; the status line that took y 0..30
+// is the Qt status bar now).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -150,9 +152,10 @@ TEST(EditorGui, PaintSurfaceAndSliceThenSaveMatchesGoldenScreenshot) {
   // painted σt between the base and the brush's set target (set mode moves towards it).
   if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
   Project p;
-  // c: from the colour brush to sigma_t, the brush this picture was made with.
+  // c: from the colour brush to sigma_t, the brush this picture was made with. The slice
+  // stroke runs along the z slice view's centre row (y 102).
   test::writeText(p.events,
-                  EventScript().key("c", 'c').drag(200, 402, 280, 402, 8).drag(760, 117, 840, 117, 8).ctrl('s').str());
+                  EventScript().key("c", 'c').drag(200, 402, 280, 402, 8).drag(760, 102, 840, 102, 8).ctrl('s').str());
   const fs::path shot = p.dir / "actual.png";
   const RunResult r =
       runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--screenshot", shot.string(), "--exit"});
