@@ -118,7 +118,7 @@ BrushPanel::BrushPanel(EditWindow& editor, QWidget* parent) : QWidget(parent), e
     auto* button = new QPushButton(QString::fromStdString(controls.swatchName(i)), this);
     button->setStyleSheet(swatchStyle(controls.swatches()[i].colour));
     button->setToolTip("paint " + QString::fromStdString(controls.swatchName(i)) + "'s colour (p / P cycle)");
-    grid->addWidget(button, int(i / 3), int(i % 3));
+    grid->addWidget(button, int(i / 4), int(i % 4));
     connect(button, &QPushButton::clicked, this, [this, i] {
       editor_.controls().pickSwatch(i);
       editor_.showMessage("picked " + editor_.controls().swatchName(i), false);

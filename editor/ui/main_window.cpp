@@ -12,6 +12,7 @@
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QScrollArea>
+#include <QScrollBar>
 #include <QStatusBar>
 #include <QThread>
 #include <QVBoxLayout>
@@ -50,8 +51,9 @@ EditMainWindow::EditMainWindow(EditSession& session, EditWindowOptions options, 
   auto* scroll = new QScrollArea();
   scroll->setWidget(panel_);
   scroll->setWidgetResizable(true);
-  scroll->setMinimumWidth(380);
+  // As wide as the panel wants, so nothing is cut off; it scrolls only vertically.
   scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  scroll->setMinimumWidth(panel_->minimumSizeHint().width() + scroll->verticalScrollBar()->sizeHint().width() + 4);
   auto* dock = new QDockWidget("Brush", this);
   dock->setObjectName("brush");
   dock->setWidget(scroll);
