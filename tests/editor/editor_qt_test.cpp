@@ -240,6 +240,15 @@ TEST(EditorQt, PreviewAsTheMainViewShowsTheRenderedObject) {
       if (!black && !background) ++object;
     }
   EXPECT_GT(double(object) / total, 0.9) << "the 3D view's centre does not show the preview's object";
+  // Its corner shows the preview's black background, not the 3D view's own (41, 43, 51):
+  // the preview is the view's background, not only something drawn inside it.
+  std::size_t black = 0, corner = 0;
+  for (int y = 20; y < 60; ++y)
+    for (int x = 20; x < 60; ++x, ++corner) {
+      const QColor c = shot.pixelColor(x, y);
+      if (c.red() + c.green() + c.blue() < 15) ++black;
+    }
+  EXPECT_GT(double(black) / corner, 0.95) << "the 3D view's corner is not the preview's background";
   // Off again: the mesh view is back and the preview keeps the scene camera's aspect.
   e.panel().previewViewBox()->setChecked(false);
   EXPECT_FALSE(e.edit().previewAsMainView());
