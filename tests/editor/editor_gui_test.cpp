@@ -383,6 +383,30 @@ TEST(EditorGui, HelpOverlayAndPreviewFollowingTheCamera) {
   EXPECT_FALSE(fs::exists(p.recovery)) << "nothing was painted, so there is nothing to recover";
 }
 
+TEST(EditorGui, BKeyMakesThePreviewThe3dView) {
+  // b: the 3D view shows the SSLPV preview as its background, so its top-left corner turns
+  // from the view's own grey-blue to the preview's black; a second b brings the mesh back.
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  Project p;
+  auto cornerBlack = [&](const std::string& events) {
+    const fs::path shot = p.dir / "shot.png";
+    test::writeText(p.events, events);
+    const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--screenshot",
+                                   shot.string(), "--exit"});
+    EXPECT_EQ(r.exitCode, 0) << r.stderrText;
+    const Image image = readImage(shot);
+    std::size_t black = 0, n = 0;
+    for (int y = 20; y < 60; ++y)
+      for (int x = 20; x < 60; ++x, ++n) {
+        const glm::vec3 c = image.at(x, y);
+        if (c.x + c.y + c.z < 0.01f) ++black;
+      }
+    return double(black) / double(n);
+  };
+  EXPECT_GT(cornerBlack(EventScript().key("b", 'b').str()), 0.95) << "b did not put the preview in the 3D view";
+  EXPECT_LT(cornerBlack(EventScript().key("b", 'b').key("b", 'b').str()), 0.05) << "a second b should bring the mesh view back";
+}
+
 std::vector<std::string> dirNames(const fs::path& dir) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
