@@ -539,6 +539,11 @@ void EditWindow::onTimer() {
     requestPreview(PreviewQuality::Draft);
   if (pollPreview()) window_->Render();
   if (painting()) return;
+  if (previewMain_) {
+    // A resized window changes the 3D view's aspect: the next frame follows it.
+    matchPreviewAspect();
+    if (session_.previewStale()) requestPreview(PreviewQuality::Full);
+  }
   maybeAutosave(false);
 }
 

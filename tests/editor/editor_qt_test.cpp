@@ -13,6 +13,7 @@
 #include <QImage>
 #include <QSurfaceFormat>
 #include <QVTKOpenGLNativeWidget.h>
+#include <vtkRenderer.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -249,6 +250,16 @@ TEST(EditorQt, PreviewAsTheMainViewShowsTheRenderedObject) {
       if (c.red() + c.green() + c.blue() < 15) ++black;
     }
   EXPECT_GT(double(black) / corner, 0.95) << "the 3D view's corner is not the preview's background";
+  // A resized window: the next timer tick asks for a frame at the view's new aspect.
+  e.window->view()->setFixedSize(kWidth, 400);
+  for (int i = 0; i < 20; ++i) QApplication::processEvents();
+  e.edit().onTimer();
+  const int* size = e.edit().view3d()->GetSize();
+  ASSERT_GT(size[1], 0);
+  EXPECT_NEAR(double(size[0]) / size[1], 480.0 / (400 * (1.0 - 0.34)), 0.02) << "the view did not resize";
+  EXPECT_NEAR(double(e.session->previewCamera().width) / e.session->previewCamera().height,
+              double(size[0]) / size[1], 0.03)
+      << "the preview did not follow the resized view";
   // Off again: the mesh view is back and the preview keeps the scene camera's aspect.
   e.panel().previewViewBox()->setChecked(false);
   EXPECT_FALSE(e.edit().previewAsMainView());
