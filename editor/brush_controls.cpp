@@ -24,8 +24,10 @@ bool valuedMode(BrushMode mode) {
   return mode == BrushMode::Set || mode == BrushMode::Add || mode == BrushMode::Multiply;
 }
 
+}  // namespace
+
 // The modes each channel accepts, in cycling order (brushProblem's rules).
-std::vector<BrushMode> modesOf(BrushChannel channel) {
+std::vector<BrushMode> BrushControls::modesOf(BrushChannel channel) {
   switch (channel) {
     case BrushChannel::Colour:
     case BrushChannel::AlbedoMfp:
@@ -37,6 +39,8 @@ std::vector<BrushMode> modesOf(BrushChannel channel) {
       return {BrushMode::Set, BrushMode::Add, BrushMode::Multiply, BrushMode::Smooth, BrushMode::Erase};
   }
 }
+
+namespace {
 
 const char* channelName(BrushChannel c) {
   switch (c) {
@@ -290,6 +294,43 @@ std::string BrushControls::artistFieldText(int field) const {
       std::snprintf(text, sizeof text, "%.6g, %.6g, %.6g", v.x, v.y, v.z);
   }
   return text;
+}
+
+void BrushControls::setChannel(BrushChannel channel) {
+  channel_ = channel;
+  const std::vector<BrushMode> modes = modesOf(channel_);
+  if (std::find(modes.begin(), modes.end(), mode_) == modes.end()) mode_ = modes.front();
+}
+
+bool BrushControls::setMode(BrushMode mode) {
+  const std::vector<BrushMode> modes = modesOf(channel_);
+  if (std::find(modes.begin(), modes.end(), mode) == modes.end()) return false;
+  mode_ = mode;
+  return true;
+}
+
+bool BrushControls::setRadius(double radius) {
+  if (!(radius > 0.0) || !std::isfinite(radius)) return false;
+  radius_ = radius;
+  return true;
+}
+
+void BrushControls::setStrength(double strength) {
+  if (std::isfinite(strength)) strength_ = std::clamp(strength, 0.0, 1.0);
+}
+
+void BrushControls::setDepth(double depth) {
+  if (std::isfinite(depth)) depth_ = std::max(0.0, depth);
+}
+
+std::string BrushControls::setArtist(const ArtistParams& artist) {
+  if (std::string problem = artistParamsProblem(artist, ior_); !problem.empty()) return problem;
+  for (int c = 0; c < 3; ++c)
+    if (artist.scatterDistance[c] > kMaxScatterDistance)
+      return "scatter_distance[" + std::to_string(c) + "]: the editor takes at most 1e30";
+  artist_ = artist;
+  selectColourChannel();
+  return {};
 }
 
 std::string BrushControls::enterArtistField(int field, const std::string& text) {

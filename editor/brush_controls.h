@@ -66,6 +66,25 @@ class BrushControls {
   void cycleMirror();  ///< off, x, y, z (across the object's rest-space centre)
   void adjustDepth(int direction);  ///< surface strokes' depth by a tenth of the radius
 
+  // Direct setters for the brush panel (editor/ui/brush_panel.cpp): the same state the keys
+  // step through, validated the same way (an unaccepted value leaves the brush unchanged).
+  BrushChannel channel() const { return channel_; }
+  BrushMode mode() const { return mode_; }
+  BrushFalloff falloff() const { return falloff_; }
+  int mirrorAxis() const { return mirrorAxis_; }
+  /// The modes `channel` accepts, in cycling order.
+  static std::vector<BrushMode> modesOf(BrushChannel channel);
+  void setChannel(BrushChannel channel);  ///< keeps the mode if the channel accepts it
+  bool setMode(BrushMode mode);           ///< false when the channel does not accept it
+  void setFalloff(BrushFalloff falloff) { falloff_ = falloff; }
+  void setMirror(int axis) { mirrorAxis_ = axis >= 0 && axis <= 2 ? axis : -1; }
+  bool setRadius(double radius);      ///< false unless finite and > 0
+  void setStrength(double strength);  ///< clamped to [0, 1]
+  void setDepth(double depth);        ///< clamped to >= 0
+  /// The colour brush's whole artist view at once (the colour dialog, the panel's fields);
+  /// "" when applied (the colour channel is selected), else why not, nothing changed.
+  std::string setArtist(const ArtistParams& artist);
+
   bool paintMode() const { return paintMode_; }
   void setPaintMode(bool on) { paintMode_ = on; }
 

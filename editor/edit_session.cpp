@@ -162,6 +162,7 @@ struct EditSession::Impl {
   PreviewChannel full, draft;
   std::string backendName;
   int previewWidth = 0, previewHeight = 0;
+  int previewLongestSide = 256;
   Camera camera;
   std::uint64_t version = 1;          ///< bumps with every change a preview shows
   std::uint64_t materialVersion = 1;  ///< bumps with every change of the voxels
@@ -279,6 +280,7 @@ EditSession::EditSession(const fs::path& sceneFile, const PreviewOptions& previe
   const double scale = double(preview.longestSide) / double(std::max(sceneCamera.width, sceneCamera.height));
   m.previewWidth = std::max(kMinPreviewSide, int(std::lround(sceneCamera.width * scale)));
   m.previewHeight = std::max(kMinPreviewSide, int(std::lround(sceneCamera.height * scale)));
+  m.previewLongestSide = preview.longestSide;
   m.camera = sceneCamera;
   m.camera.width = m.previewWidth;
   m.camera.height = m.previewHeight;
@@ -383,6 +385,21 @@ void EditSession::setPreviewCamera(const Camera& camera) {
   m.camera = camera;
   m.camera.width = m.previewWidth;
   m.camera.height = m.previewHeight;
+  m.full.cameraChanged = m.draft.cameraChanged = true;
+  ++m.version;
+}
+
+void EditSession::setPreviewAspect(double widthOverHeight) {
+  Impl& m = *impl_;
+  if (!(widthOverHeight > 0.0) || !std::isfinite(widthOverHeight)) return;
+  // Within 1:16 either way: a sliver of a window still gets a usable frame.
+  const double aspect = std::clamp(widthOverHeight, 1.0 / 16.0, 16.0);
+  const int side = m.previewLongestSide;
+  const int width = std::max(kMinPreviewSide, int(std::lround(aspect >= 1.0 ? side : side * aspect)));
+  const int height = std::max(kMinPreviewSide, int(std::lround(aspect >= 1.0 ? side / aspect : side)));
+  if (width == m.previewWidth && height == m.previewHeight) return;
+  m.previewWidth = m.camera.width = width;
+  m.previewHeight = m.camera.height = height;
   m.full.cameraChanged = m.draft.cameraChanged = true;
   ++m.version;
 }

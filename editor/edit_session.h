@@ -133,6 +133,9 @@ class EditSession {
   // below never wait for a render, except renderPreview() and waitForPreview().
   void setPreviewCamera(const Camera& camera);  ///< width/height are replaced by the preview size
   const Camera& previewCamera() const;
+  /// The preview image's width / height (the 3D view's, when the preview is the main view),
+  /// its longest side still the PreviewOptions one; junk (0, NaN) is ignored.
+  void setPreviewAspect(double widthOverHeight);
   /// True when a stroke, dab, undo, redo or camera change happened since the last request
   /// of `quality` (a Full request or renderPreview() also satisfies Draft).
   bool previewStale(PreviewQuality quality = PreviewQuality::Full) const;

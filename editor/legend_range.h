@@ -3,6 +3,8 @@
 // refitted after every dab, the colours of the voxels the stroke never touched would
 // shift with each one (the whole slice flickers). Held, the range stays as the stroke
 // found it, values beyond it show in the end colours, and the release refits once.
+// Locked by the user, the range is theirs for every channel until unlocked: the same
+// colour means the same value across strokes, channels and sessions of comparison.
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -17,6 +19,7 @@ class LegendRange {
   /// The range to show for `channel` whose values span [lo, hi]. Held, the previous range
   /// of the same channel; another channel is always fitted.
   std::pair<double, double> fit(const std::string& channel, double lo, double hi) {
+    if (locked_) return *locked_;
     if (held_ && range_ && channel == channel_) return *range_;
     // A uniform slice still needs a visible legend range.
     if (!(hi > lo)) {
@@ -29,7 +32,19 @@ class LegendRange {
     return *range_;
   }
 
+  /// Fixes the range to [lo, hi]; false (nothing changes) unless both are finite and lo < hi.
+  bool lock(double lo, double hi) {
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi)) return false;
+    locked_ = std::make_pair(lo, hi);
+    return true;
+  }
+  void unlock() { locked_.reset(); }
+  bool locked() const { return locked_.has_value(); }
+  /// The range last shown (locked or fitted); absent before the first fit.
+  std::optional<std::pair<double, double>> current() const { return locked_ ? locked_ : range_; }
+
  private:
+  std::optional<std::pair<double, double>> locked_;
   bool held_ = false;
   std::string channel_;
   std::optional<std::pair<double, double>> range_;

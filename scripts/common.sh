@@ -8,11 +8,13 @@ SSLPV_BUILD="${SSLPV_BUILD:-$SSLPV_ROOT/build}"
 # libclang-rt-14-dev; libfuzzer-14-dev only adds the standalone library, unused here).
 # curl: sanitize.sh tsan fetches Debian's oneTBB source package to instrument it.
 # python3: the layer check (scripts/check_layers.py), a CTest test.
+# libvtk9-qt-dev, qtbase5-dev, libx11-dev: the editor, VTK's views in a Qt 5 main window
+# (QVTKOpenGLNativeWidget); X11 to check the display before Qt would abort on a bad one.
 SSLPV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libglm-dev libembree-dev
   libassimp-dev nlohmann-json3-dev libcli11-dev libopenexr-dev libstb-dev
-  libgtest-dev libgmock-dev libvtk9-dev xvfb xauth libglfw3-dev
+  libgtest-dev libgmock-dev libvtk9-dev libvtk9-qt-dev qtbase5-dev libx11-dev xvfb xauth libglfw3-dev
   libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools vulkan-validationlayers
   clang-14 libclang-rt-14-dev curl python3
 )

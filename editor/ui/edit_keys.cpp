@@ -1,5 +1,6 @@
-// The editor window's keyboard: brush controls, undo/redo, files, help, quitting, and the
-// typed paths of "export material set" and "save as". Kept apart from the window's layout and painting.
+// The editor window's keyboard and file operations: brush controls, undo/redo, files, help,
+// quitting, the typed paths of "export material set" and "save as" (the keys' way), and
+// the same operations as the Qt menus call them. Kept apart from the layout and painting.
 #include <vtkActor.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -11,6 +12,61 @@
 #include "editor/ui/edit_window.h"
 
 namespace sslpv {
+
+EditWindow::FileOutcome EditWindow::saveFile(bool replaceConfirmed, std::string* why) {
+  FileOutcome outcome = FileOutcome::Done;
+  try {
+    session_.save(replaceConfirmed);
+    showMessage("saved " + session_.paths().saveTarget.filename().string(), false);
+  } catch (const SaveNeedsConfirmation& e) {
+    if (why) *why = e.what();
+    outcome = FileOutcome::NeedsConfirmation;
+  } catch (const std::exception& e) {
+    // The session kept its state and the previous file: say so, keep working.
+    if (why) *why = e.what();
+    showMessage(std::string("save failed, nothing lost (changes still in memory): ") + e.what(), true);
+    outcome = FileOutcome::Failed;
+  }
+  updateStatus();
+  return outcome;
+}
+
+EditWindow::FileOutcome EditWindow::saveFileAs(const std::string& path, bool replaceConfirmed, std::string* why) {
+  FileOutcome outcome = FileOutcome::Done;
+  try {
+    session_.saveAs(path, replaceConfirmed);
+    showMessage("saved as " + path + " (the scene now uses it)", false);
+  } catch (const SaveNeedsConfirmation& e) {
+    if (why) *why = e.what();
+    outcome = FileOutcome::NeedsConfirmation;
+  } catch (const std::exception& e) {
+    if (why) *why = e.what();
+    showMessage(std::string("save as failed: ") + e.what(), true);
+    outcome = FileOutcome::Failed;
+  }
+  updateStatus();
+  return outcome;
+}
+
+EditWindow::FileOutcome EditWindow::exportFile(const std::string& path, std::string* why) {
+  try {
+    session_.exportMaterialSet(path);
+    showMessage("exported material set to " + path, false);
+    return FileOutcome::Done;
+  } catch (const std::exception& e) {
+    if (why) *why = e.what();
+    showMessage(std::string("export failed: ") + e.what(), true);
+    return FileOutcome::Failed;
+  }
+}
+
+void EditWindow::undo() { afterChange(session_.undo(), "undo"); }
+void EditWindow::redo() { afterChange(session_.redo(), "redo"); }
+
+void EditWindow::quitWithoutSaving() {
+  quit_ = true;
+  quitArmed_ = true;
+}
 
 void EditWindow::startPrompt(PromptKind kind) {
   const std::filesystem::path& scene = session_.paths().scene;
@@ -89,9 +145,9 @@ bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char k
   bool handled = true;
   if (ctrl) {
     if (lower == "z" && !shift) {
-      afterChange(session_.undo(), "undo");
+      undo();
     } else if ((lower == "z" && shift) || lower == "y") {
-      afterChange(session_.redo(), "redo");
+      redo();
     } else if (lower == "s" && shift) {
       startPrompt(PromptKind::SaveAs);
     } else if (lower == "s") {
@@ -151,6 +207,14 @@ bool EditWindow::handleKey(const std::string& key, bool ctrl, bool shift, char k
     controls_.cycleMirror();
   } else if (lower == "i") {
     controls_.adjustDepth(shift ? -1 : 1);
+  } else if (key == "b") {
+    setPreviewAsMainView(!previewMain_);
+  } else if (key == "l") {
+    if (sliceRangeLocked()) {
+      unlockSliceRange();
+    } else if (const auto range = sliceRange()) {
+      lockSliceRange(range->first, range->second);
+    }
   } else if (key == "h" || key == "question" || key == "F1") {
     helpVisible_ = !helpVisible_;
     help_->SetVisibility(helpVisible_);

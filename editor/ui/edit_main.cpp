@@ -1,9 +1,17 @@
 // sslpv-edit: the editor window (`sslpv edit` runs this program). A separate program so
-// the command-line tool never loads VTK and its X11 dependencies.
+// the command-line tool never loads Qt, VTK and their X11 dependencies.
 //
 // Scripted use (tests, bug reports): --play replays a vtkInteractorEventRecorder script
-// (StreamVersion 1.1), --screenshot writes the window afterwards, --exit ends the program
-// then instead of waiting for the user; --record writes the user's events as a script.
+// (StreamVersion 1.1) on the views' interactor, --screenshot writes the views afterwards
+// (--screenshot-window: the whole Qt window with panel, menus and status bar), --exit
+// ends the program then instead of waiting for the user; --record writes the user's
+// events as a script.
+#include <QApplication>
+#include <QImage>
+#include <QPixmap>
+#include <QSurfaceFormat>
+#include <QTimer>
+#include <QVTKOpenGLNativeWidget.h>
 #include <vtkInteractorEventRecorder.h>
 #include <vtkPNGWriter.h>
 #include <vtkRenderWindow.h>
@@ -24,8 +32,11 @@
 #include "editor/edit_session.h"
 #include "editor/ui/edit_input.h"
 #include "editor/ui/edit_window.h"
+#include "editor/ui/main_window.h"
 #include "volume/core/atomic_file.h"
 #include "volume/core/error.h"
+// Last: Xlib's macros (None, Status, Bool) would clash with the headers above.
+#include <X11/Xlib.h>
 
 namespace {
 
@@ -34,7 +45,7 @@ using namespace sslpv;
 constexpr int kExitInput = 2, kExitResource = 3;
 
 struct Options {
-  std::string scene, backend = "vulkan", steps, play, record, screenshot, size = "1280x800";
+  std::string scene, backend = "vulkan", steps, play, record, screenshot, screenshotWindow, size = "1280x800";
   std::optional<int> grid;
   int previewSize = 256;
   double autosaveSeconds = 5.0;
@@ -42,9 +53,17 @@ struct Options {
   bool backendGiven = false;  ///< --backend on the command line: no silent fallback
 };
 
-bool haveDisplay() {
+// Qt aborts the process (exit 134) when it cannot connect to the display: find out first,
+// so a wrong DISPLAY is a one-line error with the resource exit code.
+std::string displayProblem() {
   const char* display = std::getenv("DISPLAY");
-  return display != nullptr && *display != '\0';
+  if (display == nullptr || *display == '\0')
+    return "no X display (DISPLAY is not set): the editor needs one; run it under xvfb-run for scripted use";
+  Display* connection = XOpenDisplay(nullptr);
+  if (connection == nullptr)
+    return std::string("cannot open the X display '") + display + "': the editor needs one; run it under xvfb-run";
+  XCloseDisplay(connection);
+  return {};
 }
 
 void writeScreenshot(vtkRenderWindow* window, const std::string& file) {
@@ -75,7 +94,7 @@ std::string readText(const std::string& file) {
 // from a desktop never sees the terminal.
 int showStartupError(const Options& options, const std::string& message, int exitCode) {
   std::fprintf(stderr, "sslpv edit: %s\n", message.c_str());
-  if (!haveDisplay()) return exitCode;
+  if (!displayProblem().empty()) return exitCode;
   auto window = vtkSmartPointer<vtkRenderWindow>::New();
   window->SetSize(900, 200);
   window->SetWindowName("sslpv edit - cannot open the scene");
@@ -134,22 +153,29 @@ int run(const Options& options) {
   } catch (const InputError& e) {
     return showStartupError(options, e.what(), kExitInput);
   }
-  if (!haveDisplay())
-    throw ResourceError("no X display (DISPLAY is not set): the editor needs one; run it under xvfb-run for scripted use");
+  if (const std::string problem = displayProblem(); !problem.empty()) throw ResourceError(problem);
+  if (!options.screenshotWindow.empty()) requireWritableOutput(options.screenshotWindow);
 
   if (options.recover) session->recover();
   if (options.discardRecovery) session->discardRecovery();
 
+  // The views need an OpenGL 3.2 core context, asked for before the application exists.
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  int qtArgc = 1;
+  char programName[] = "sslpv-edit";
+  char* qtArgv[] = {programName, nullptr};
+  QApplication app(qtArgc, qtArgv);
   EditWindowOptions windowOptions;
-  windowOptions.width = width;
-  windowOptions.height = height;
   windowOptions.autosaveSeconds = options.autosaveSeconds;
   windowOptions.offerRecovery = !options.recover && !options.discardRecovery;
-  EditWindow window(*session, windowOptions);
+  EditMainWindow mainWindow(*session, windowOptions, width, height);
+  mainWindow.show();
+  if (!mainWindow.waitUntilReady(30.0))
+    throw ResourceError("the editor's views got no OpenGL context (3.2 core) from the X display");
+  EditWindow& window = mainWindow.editor();
   if (!fallbackNote.empty()) window.showMessage(fallbackNote, false);
   attachEditorInput(window);
   vtkRenderWindowInteractor* interactor = window.interactor();
-  interactor->Initialize();
   window.refresh();
 
   vtkSmartPointer<vtkInteractorEventRecorder> recorder;
@@ -169,6 +195,16 @@ int run(const Options& options) {
     window.settlePreview();
     writeScreenshot(window.renderWindow(), options.screenshot);
   }
+  if (!options.screenshotWindow.empty()) {
+    if (options.screenshot.empty()) window.settlePreview();
+    window.refresh();
+    QApplication::processEvents();
+    const QImage shot = mainWindow.grab().toImage();
+    writeAtomically(options.screenshotWindow, [&](const std::filesystem::path& temp) {
+      if (!shot.save(QString::fromStdString(temp.string()), "PNG"))
+        throw ResourceError(options.screenshotWindow + ": could not write the screenshot");
+    });
+  }
   if (!options.exitAfter && !window.quitRequested()) {
     if (!options.record.empty()) {
       recorder->SetFileName(options.record.c_str());
@@ -176,9 +212,16 @@ int run(const Options& options) {
       recorder->Record();
     }
     // Also how finished preview frames reach the screen: 50 ms keeps their delay short
-    // (a poll is two uncontended mutex locks).
-    interactor->CreateRepeatingTimer(50);
-    interactor->Start();
+    // (a poll is two uncontended mutex locks). The keys' quit (q, e) ends the loop here.
+    QTimer timer;
+    QObject::connect(&timer, &QTimer::timeout, [&] {
+      window.onTimer();
+      if (window.quitRequested()) mainWindow.close();
+    });
+    timer.start(50);
+    // From here the user may resize the views; scripted events above needed --size.
+    mainWindow.releaseViewSize();
+    QApplication::exec();
     if (recorder) recorder->Stop();
   }
   window.onClose();
@@ -206,7 +249,9 @@ int main(int argc, char** argv) {
   app.add_flag("--discard-recovery", options.discardRecovery, "Delete unsaved work of an earlier session");
   app.add_option("--play", options.play, "Replay a vtkInteractorEventRecorder event script after start-up");
   app.add_option("--record", options.record, "Record this session's events to a script");
-  app.add_option("--screenshot", options.screenshot, "Write the window as PNG after start-up (and --play)");
+  app.add_option("--screenshot", options.screenshot, "Write the views as PNG after start-up (and --play)");
+  app.add_option("--screenshot-window", options.screenshotWindow,
+                 "Write the whole window (panel, menus, status bar) as PNG after start-up (and --play)");
   app.add_flag("--exit", options.exitAfter, "Exit after --play/--screenshot instead of waiting for the user");
   try {
     app.parse(argc, argv);

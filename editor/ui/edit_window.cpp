@@ -35,7 +35,8 @@
 namespace sslpv {
 namespace {
 
-// Window layout (normalized viewports): 3D view and preview on top, three slices below.
+// Window layout (normalized viewports): 3D view and preview on top, three slices below
+// (the status line is the Qt window's status bar).
 constexpr double kSliceRowTop = 0.34;
 constexpr int kSliceSamples = 128;
 
@@ -63,6 +64,8 @@ const char* kHelpText =
     "  Ctrl+Z       undo        Ctrl+Y, Ctrl+Shift+Z   redo\n"
     "  Ctrl+S       save        Ctrl+Shift+S  save as (type a path)\n"
     "  Ctrl+E       export a copy of the material set (type a path)\n"
+    "  b            the live SSLPV preview as the 3D view (mesh hidden) / back\n"
+    "  l            lock the slices' colour range where it is / unlock\n"
     "  R / D        recover / discard unsaved work from a previous session\n"
     "  h, ?, F1     this help   q, e   quit (asks when there are unsaved changes)\n"
     "  VTK camera keys: r reset, f fly to, w wireframe, s surface, 3 stereo";
@@ -126,11 +129,11 @@ vtkRenderWindow* EditWindow::renderWindow() const { return window_; }
 vtkRenderWindowInteractor* EditWindow::interactor() const { return interactor_; }
 
 void EditWindow::buildScene() {
-  window_ = vtkSmartPointer<vtkRenderWindow>::New();
-  window_->SetSize(options_.width, options_.height);
+  if (!options_.host || !options_.host->GetInteractor())
+    throw ResourceError("the editor's views need a render window with an interactor");
+  window_ = options_.host;
   window_->SetNumberOfLayers(2);
-  interactor_ = vtkSmartPointer<vtkRenderWindowInteractor>::New();
-  interactor_->SetRenderWindow(window_);
+  interactor_ = window_->GetInteractor();
 
   view3d_ = vtkSmartPointer<vtkRenderer>::New();
   view3d_->SetViewport(0.0, kSliceRowTop, 0.5, 1.0);
@@ -144,18 +147,11 @@ void EditWindow::buildScene() {
   std::array<vtkRenderer*, 3> slices{};
   for (int a = 0; a < 3; ++a) {
     sliceViews_[a] = vtkSmartPointer<vtkRenderer>::New();
-    // Bottom row; a small gap at the top leaves room for the status line.
-    sliceViews_[a]->SetViewport(a / 3.0, 0.05, (a + 1) / 3.0, kSliceRowTop);
+    sliceViews_[a]->SetViewport(a / 3.0, 0.0, (a + 1) / 3.0, kSliceRowTop);
     window_->AddRenderer(sliceViews_[a]);
     slices[a] = sliceViews_[a];
   }
-  // Layer 1 (the overlay) does not clear: every pixel needs a layer-0 renderer under it,
-  // or old text would pile up in the status line.
-  auto statusBar = vtkSmartPointer<vtkRenderer>::New();
-  statusBar->SetViewport(0.0, 0.0, 1.0, 0.05);
-  statusBar->SetBackground(0.0, 0.0, 0.0);
-  statusBar->InteractiveOff();
-  window_->AddRenderer(statusBar);
+  // Layer 1 (the overlay) does not clear: the layer-0 renderers above cover every pixel.
   overlay_ = vtkSmartPointer<vtkRenderer>::New();
   overlay_->SetLayer(1);
   overlay_->InteractiveOff();
@@ -211,10 +207,6 @@ void EditWindow::buildScene() {
   previewActor_->GetMapper()->SetInputData(previewImage_);
   preview_->AddViewProp(previewActor_);
 
-  status_ = makeText(overlay_, 13, 0.005, 0.012);
-  message_ = makeText(overlay_, 14, 0.005, 0.99);
-  message_->GetTextProperty()->SetVerticalJustificationToTop();
-  unsavedMarker_ = makeText(overlay_, 14, 0.005, 0.93);
   previewLabel_ = makeText(overlay_, 12, 0.505, 0.965);
   previewLabel_->GetTextProperty()->SetColor(0.8, 0.8, 0.8);
   previewProgress_ = makeText(overlay_, 15, 0.75, 0.5 * (1.0 + kSliceRowTop));
@@ -329,54 +321,39 @@ void EditWindow::updatePreviewLabel() {
 }
 
 void EditWindow::updateStatus() {
-  status_->SetInput((controls_.describe() + "   | h: help").c_str());
   updateSwatches();
-  const bool unsaved = session_.unsaved();
-  unsavedMarker_->SetInput(unsaved ? "* unsaved changes" : "saved");
-  unsavedMarker_->GetTextProperty()->SetColor(unsaved ? 1.0 : 0.6, unsaved ? 0.6 : 0.6, unsaved ? 0.2 : 0.6);
-  const std::string title = "sslpv edit - " + session_.paths().scene.filename().string() + (unsaved ? " *" : "");
-  window_->SetWindowName(title.c_str());
+  if (stateListener_) stateListener_();
+}
+
+std::string EditWindow::statusText() const {
+  std::string text = controls_.describe();
+  if (previewMain_) text += " | 3D view: SSLPV preview";
+  if (slices_ && slices_->range().locked()) text += " | range locked";
+  return text + "   | h: help";
+}
+
+void EditWindow::setListeners(std::function<void()> state, std::function<void(const std::string&, bool)> message) {
+  stateListener_ = std::move(state);
+  messageListener_ = std::move(message);
+  // A message from before the listeners existed (the recovery question at start-up).
+  if (messageListener_ && !lastMessage_.empty()) messageListener_(lastMessage_, lastMessageError_);
+  if (stateListener_) stateListener_();
 }
 
 void EditWindow::showMessage(const std::string& text, bool error) {
-  // Wrapped to the left half of the window (the 3D view), so a long error does not run
-  // over the preview on the right; lines grow downward from the top edge.
-  const int width = window_ ? window_->GetSize()[0] : 0;
-  const std::size_t columns = std::max<std::size_t>(30, std::size_t(width > 0 ? width / 2 / 9 : 60));
-  std::string wrapped;
-  std::size_t lineLength = 0;
-  std::size_t at = 0;
-  while (at < text.size()) {
-    std::size_t end = text.find_first_of(" \n", at);
-    if (end == std::string::npos) end = text.size();
-    const std::string word = text.substr(at, end - at);
-    if (lineLength > 0 && lineLength + 1 + word.size() > columns) {
-      wrapped += "\n";
-      lineLength = 0;
-    } else if (lineLength > 0) {
-      wrapped += " ";
-      ++lineLength;
-    }
-    wrapped += word;
-    lineLength += word.size();
-    if (end < text.size() && text[end] == '\n') {
-      wrapped += "\n";
-      lineLength = 0;
-    }
-    at = end + 1;
-  }
-  message_->SetInput(wrapped.c_str());
   if (error) {
-    message_->GetTextProperty()->SetColor(1.0, 0.3, 0.3);
+    // Also on stderr: scripted runs and bug reports read it there.
     std::string line = text;
     std::replace(line.begin(), line.end(), '\n', ' ');
     std::fprintf(stderr, "sslpv edit: %s\n", line.c_str());
-  } else {
-    message_->GetTextProperty()->SetColor(0.9, 0.9, 0.9);
   }
+  lastMessage_ = text;
+  lastMessageError_ = error;
+  if (messageListener_) messageListener_(text, error);
 }
 
 void EditWindow::refresh() {
+  matchPreviewAspect();
   if (session_.previewStale()) requestPreview(PreviewQuality::Full);
   pollPreview();
   updateStatus();
@@ -435,7 +412,11 @@ void EditWindow::placeCursor(int x, int y) {
   if (controls_.paintMode() && !prompt_) {
     vtkRenderer* target = rendererAt(x, y);
     if (target == view3d_.Get()) {
-      if (picker_->Pick(x, y, 0.0, view3d_)) {
+      // The picker skips hidden actors; the mesh is hidden under the preview-as-view.
+      meshActor_->SetVisibility(true);
+      const bool hit = picker_->Pick(x, y, 0.0, view3d_) != 0;
+      meshActor_->SetVisibility(!previewMain_);
+      if (hit) {
         double p[3];
         picker_->GetPickPosition(p);
         at = glm::dvec3(p[0], p[1], p[2]);
@@ -534,17 +515,11 @@ bool EditWindow::moveSliceAt(int x, int y, int steps) {
 }
 
 void EditWindow::save(bool replaceConfirmed) {
-  try {
-    session_.save(replaceConfirmed);
-    showMessage("saved " + session_.paths().saveTarget.filename().string(), false);
-  } catch (const SaveNeedsConfirmation& e) {
+  std::string why;
+  if (saveFile(replaceConfirmed, &why) == FileOutcome::NeedsConfirmation) {
     saveArmed_ = true;
-    showMessage(std::string(e.what()) + "\nCtrl+S again replaces it; Ctrl+Shift+S saves as another file", true);
-  } catch (const std::exception& e) {
-    // The session kept its state and the previous file: say so, keep working.
-    showMessage(std::string("save failed, nothing lost (changes still in memory): ") + e.what(), true);
+    showMessage(why + "\nCtrl+S again replaces it; Ctrl+Shift+S saves as another file", true);
   }
-  updateStatus();
 }
 
 void EditWindow::maybeAutosave(bool strokeJustEnded) {
@@ -564,6 +539,11 @@ void EditWindow::onTimer() {
     requestPreview(PreviewQuality::Draft);
   if (pollPreview()) window_->Render();
   if (painting()) return;
+  if (previewMain_) {
+    // A resized window changes the 3D view's aspect: the next frame follows it.
+    matchPreviewAspect();
+    if (session_.previewStale()) requestPreview(PreviewQuality::Full);
+  }
   maybeAutosave(false);
 }
 

@@ -1,16 +1,21 @@
 #pragma once
-// The editor's VTK window: a 3D view of the object with the slices inside it (trackball
-// camera), the live SSLPV preview seen through the 3D view's camera, three 2D slice views
-// with a colour legend, a status line, messages and a help overlay. Painting, keys and
-// files go through EditSession; this class only maps input to it and shows its state.
+// The editor's VTK views, drawn into the render window of the Qt main window's central
+// widget (editor/ui/main_window.h): a 3D view of the object with the slices inside it
+// (trackball camera), the live SSLPV preview seen through the 3D view's camera (or, toggled,
+// as the 3D view itself), three 2D slice views with a colour legend, the swatch row and a
+// help overlay. The status line and messages go to listeners (the Qt status bar).
+// Painting, keys and files go through EditSession; this class only maps input to it and
+// shows its state, so the keys, the mouse and the Qt panel and menus share one code path.
 #include <vtkSmartPointer.h>
 
 #include <array>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "editor/brush_controls.h"
@@ -24,13 +29,15 @@ class vtkRenderWindow;
 class vtkRenderWindowInteractor;
 class vtkRenderer;
 class vtkTextActor;
+class vtkTexture;
 
 namespace sslpv {
 
 class SliceViews;
 
 struct EditWindowOptions {
-  int width = 1280, height = 800;
+  /// The render window to draw into (the Qt widget's, with its interactor); required.
+  vtkRenderWindow* host = nullptr;
   double autosaveSeconds = 5.0;  ///< after the last change; 0: after every stroke
   bool offerRecovery = true;     ///< false when --recover/--discard-recovery answered already
 };
@@ -42,8 +49,40 @@ class EditWindow {
 
   vtkRenderWindow* renderWindow() const;
   vtkRenderWindowInteractor* interactor() const;
-  /// Shows a one-line message (errors in red) until the next message or key press.
+  /// Hands a message to the message listener (errors in red there, and on stderr).
   void showMessage(const std::string& text, bool error);
+  /// `state`: the brush, the unsaved flag or the range changed (status bar, panel, title);
+  /// `message`: showMessage's text.
+  void setListeners(std::function<void()> state, std::function<void(const std::string&, bool)> message);
+  /// The status line: the brush as BrushControls::describe() says, and the view modes.
+  std::string statusText() const;
+  BrushControls& controls() { return controls_; }
+  const EditSession& session() const { return session_; }
+  /// The panel changed the brush: the slices, the cursor and the status follow.
+  void brushChanged();
+
+  // Files and history for the menus: the same EditSession rules as the keys (a set
+  // sslpv did not write is replaced only when `replaceConfirmed`; every write atomic).
+  enum class FileOutcome { Done, NeedsConfirmation, Failed };
+  FileOutcome saveFile(bool replaceConfirmed, std::string* why = nullptr);
+  FileOutcome saveFileAs(const std::string& path, bool replaceConfirmed, std::string* why = nullptr);
+  FileOutcome exportFile(const std::string& path, std::string* why = nullptr);
+  void undo();
+  void redo();
+  /// The user chose to quit without saving (the menu's question): no recovery file is kept.
+  void quitWithoutSaving();
+
+  /// The live SSLPV preview as the 3D view: rendered at the view's aspect through its
+  /// camera, drawn as its background, the mesh and 3D slices hidden, the cursor on top.
+  void setPreviewAsMainView(bool on);
+  bool previewAsMainView() const { return previewMain_; }
+  /// A fixed slice colour range (the legend stops refitting); false for an empty range.
+  bool lockSliceRange(double lo, double hi);
+  void unlockSliceRange();
+  bool sliceRangeLocked() const;
+  /// The range the slices show now (locked or fitted).
+  std::optional<std::pair<double, double>> sliceRange() const;
+  vtkRenderer* view3d() const;
   /// Requests a preview of the current state if stale, shows a finished one, redraws.
   void refresh();
   /// Waits for the preview frames requested so far and shows the newest (scripted runs:
@@ -61,7 +100,7 @@ class EditWindow {
   void continuePaint(int x, int y);
   void endPaint();
   bool painting() const { return paintView_ != PaintView::None; }
-  bool is3dView(const vtkRenderer* renderer) const { return renderer != nullptr && renderer == view3d_.Get(); }
+  bool is3dView(const vtkRenderer* renderer) const;
   /// The mouse moved without painting: the brush cursor follows it (paint mode only).
   void hover(int x, int y);
   /// The 3D view's camera moved: the preview follows it.
@@ -82,6 +121,8 @@ class EditWindow {
   void showFrame(const PreviewFrame& frame);
   void updatePreviewLabel();
   void updateStatus();
+  /// Re-reads the 3D view's aspect for the preview (preview-as-main-view only).
+  void matchPreviewAspect();
   void afterChange(const std::optional<StrokeResult>& result, const char* what);
   void save(bool replaceConfirmed);
   enum class PromptKind { Export, SaveAs };
@@ -119,7 +160,13 @@ class EditWindow {
   vtkSmartPointer<vtkCellPicker> picker_;
   vtkSmartPointer<vtkImageData> previewImage_;
   vtkSmartPointer<vtkImageActor> previewActor_;
-  vtkSmartPointer<vtkTextActor> status_, message_, help_, unsavedMarker_, previewLabel_;
+  vtkSmartPointer<vtkTextActor> help_, previewLabel_;
+  vtkSmartPointer<vtkTexture> background_;  ///< the preview as the 3D view's background
+  bool previewMain_ = false;
+  std::function<void()> stateListener_;
+  std::function<void(const std::string&, bool)> messageListener_;
+  std::string lastMessage_;
+  bool lastMessageError_ = false;
   vtkSmartPointer<vtkTextActor> storedView_;  ///< the colour brush's σ view, beside the swatches
 
   PaintView paintView_ = PaintView::None;

@@ -162,6 +162,10 @@ void SliceViews::update(const MaterialField& field, const std::string& channel, 
   legend_->SetTitle(title.c_str());
 }
 
+void SliceViews::setVisibleIn3d(bool on) {
+  for (int a = 0; a < 3; ++a) actors3d_[a]->SetVisibility(on);
+}
+
 std::optional<int> SliceViews::axisOf(const vtkRenderer* renderer) const {
   for (int a = 0; a < 3; ++a)
     if (views_[a] == renderer) return a;

@@ -40,7 +40,12 @@ class SliceViews {
   void update(const MaterialField& field, const std::string& channel, const std::string& units);
   /// During a stroke: update() keeps the colour range (editor/legend_range.h).
   void holdRange(bool on) { range_.hold(on); }
+  /// The user's fixed colour range (the panel's "lock range"); update() then never refits.
+  LegendRange& range() { return range_; }
+  const LegendRange& range() const { return range_; }
 
+  /// Shows or hides the slices and the legend inside the 3D view (the 2D views keep theirs).
+  void setVisibleIn3d(bool on);
   /// The slice axis that `renderer` shows, if it is one of the slice views.
   std::optional<int> axisOf(const vtkRenderer* renderer) const;
   /// The world point on slice `axis` under display position (x, y) of its view.

@@ -217,5 +217,34 @@ TEST(BrushControls, SwatchesAreTheJensenMaterialsAndTypedEntryIsChecked) {
   EXPECT_EQ(controls.brush().artist.colour, glm::dvec3(0.8, 0.4, 0.1)) << "a refused entry changes nothing";
 }
 
+TEST(BrushControls, PanelSettersValidateLikeTheKeys) {
+  // The brush panel sets values directly; junk (NaN, 0, a mode the channel refuses, an
+  // out-of-range colour) leaves the brush as it was and usable.
+  BrushControls controls(base(), 10.0, "mm", 1.3);
+  const Brush before = controls.brush();
+  EXPECT_FALSE(controls.setRadius(std::nan("")));
+  EXPECT_FALSE(controls.setRadius(0.0));
+  EXPECT_DOUBLE_EQ(controls.brush().radius, before.radius);
+  EXPECT_TRUE(controls.setRadius(2.5));
+  EXPECT_DOUBLE_EQ(controls.brush().radius, 2.5);
+  controls.setStrength(7.0);
+  EXPECT_DOUBLE_EQ(controls.brush().strength, 1.0);
+  controls.setDepth(-1.0);
+  EXPECT_DOUBLE_EQ(controls.brush().depth, 0.0);
+  EXPECT_FALSE(controls.setMode(BrushMode::Add)) << "the colour channel only sets";
+  controls.setChannel(BrushChannel::All);
+  EXPECT_EQ(controls.brush().mode, BrushMode::Smooth) << "a channel change picks an accepted mode";
+  ArtistParams bad = controls.artist();
+  bad.colour = glm::dvec3(1.5);
+  EXPECT_NE(controls.setArtist(bad), "");
+  EXPECT_EQ(controls.brush().channel, BrushChannel::All) << "a refused colour changes nothing";
+  ArtistParams good = controls.artist();
+  good.colour = glm::dvec3(0.5, 0.3, 0.1);
+  EXPECT_EQ(controls.setArtist(good), "");
+  EXPECT_EQ(controls.brush().channel, BrushChannel::Colour);
+  EXPECT_EQ(controls.brush().artist.colour, good.colour);
+  EXPECT_EQ(brushProblem(controls.brush()), "");
+}
+
 }  // namespace
 }  // namespace sslpv

@@ -3,8 +3,10 @@
 // screenshot are checked. Skips loudly where the editor was not built (no VTK) or
 // xvfb-run is missing.
 //
-// Window 960x600 (--size): the 3D view covers x 0..480, y 204..600 (VTK's y goes up), the
-// three slice views x 0..320, 320..640, 640..960 at y 30..204 (slices across x, y, z).
+// Views 960x600 (--size; the Qt window's panel, menus and status bar come on top): the 3D
+// view covers x 0..480, y 204..600 (VTK's y goes up), the three slice views x 0..320,
+// 320..640, 640..960 at y 0..204 (slices across x, y, z; the status line that took y 0..30
+// is the Qt status bar now).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -150,9 +152,10 @@ TEST(EditorGui, PaintSurfaceAndSliceThenSaveMatchesGoldenScreenshot) {
   // painted σt between the base and the brush's set target (set mode moves towards it).
   if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
   Project p;
-  // c: from the colour brush to sigma_t, the brush this picture was made with.
+  // c: from the colour brush to sigma_t, the brush this picture was made with. The slice
+  // stroke runs along the z slice view's centre row (y 102).
   test::writeText(p.events,
-                  EventScript().key("c", 'c').drag(200, 402, 280, 402, 8).drag(760, 117, 840, 117, 8).ctrl('s').str());
+                  EventScript().key("c", 'c').drag(200, 402, 280, 402, 8).drag(760, 102, 840, 102, 8).ctrl('s').str());
   const fs::path shot = p.dir / "actual.png";
   const RunResult r =
       runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--screenshot", shot.string(), "--exit"});
@@ -378,6 +381,30 @@ TEST(EditorGui, HelpOverlayAndPreviewFollowingTheCamera) {
   // Preview: x 480..960, rows 20..396 (below its label line).
   EXPECT_GT(changedFraction(a, c, 480, 20, 960, 396), 0.02) << "the preview did not follow the camera";
   EXPECT_FALSE(fs::exists(p.recovery)) << "nothing was painted, so there is nothing to recover";
+}
+
+TEST(EditorGui, BKeyMakesThePreviewThe3dView) {
+  // b: the 3D view shows the SSLPV preview as its background, so its top-left corner turns
+  // from the view's own grey-blue to the preview's black; a second b brings the mesh back.
+  if (const std::string why = editorSkipReason(); !why.empty()) GTEST_SKIP() << why;
+  Project p;
+  auto cornerBlack = [&](const std::string& events) {
+    const fs::path shot = p.dir / "shot.png";
+    test::writeText(p.events, events);
+    const RunResult r = runEditor({p.scene.string(), "--size", "960x600", "--play", p.events.string(), "--screenshot",
+                                   shot.string(), "--exit"});
+    EXPECT_EQ(r.exitCode, 0) << r.stderrText;
+    const Image image = readImage(shot);
+    std::size_t black = 0, n = 0;
+    for (int y = 20; y < 60; ++y)
+      for (int x = 20; x < 60; ++x, ++n) {
+        const glm::vec3 c = image.at(x, y);
+        if (c.x + c.y + c.z < 0.01f) ++black;
+      }
+    return double(black) / double(n);
+  };
+  EXPECT_GT(cornerBlack(EventScript().key("b", 'b').str()), 0.95) << "b did not put the preview in the 3D view";
+  EXPECT_LT(cornerBlack(EventScript().key("b", 'b').key("b", 'b').str()), 0.05) << "a second b should bring the mesh view back";
 }
 
 std::vector<std::string> dirNames(const fs::path& dir) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace sslpv {
 namespace {
 
@@ -29,6 +31,20 @@ TEST(LegendRange, AUniformSliceGetsAVisibleRange) {
   // A held range that started uniform stays the padded one.
   range.hold(true);
   EXPECT_EQ(range.fit("sigma_t", 2.0, 3.0), std::make_pair(lo, hi));
+}
+
+TEST(LegendRange, LockedRangeIgnoresValuesChannelsAndHoldsUntilUnlocked) {
+  LegendRange range;
+  range.fit("sigma_t", 1.0, 2.0);
+  EXPECT_FALSE(range.lock(2.0, 1.0)) << "an empty range is refused";
+  EXPECT_FALSE(range.lock(0.0, std::nan("")));
+  EXPECT_FALSE(range.locked());
+  ASSERT_TRUE(range.lock(0.5, 3.0));
+  EXPECT_EQ(range.fit("sigma_t", 1.0, 9.0), std::make_pair(0.5, 3.0)) << "a stroke's values do not refit it";
+  EXPECT_EQ(range.fit("g", -0.2, 0.6), std::make_pair(0.5, 3.0)) << "nor another channel";
+  EXPECT_EQ(range.current(), std::make_optional(std::make_pair(0.5, 3.0)));
+  range.unlock();
+  EXPECT_EQ(range.fit("sigma_t", 1.0, 9.0), std::make_pair(1.0, 9.0)) << "unlocked: fitted again";
 }
 
 }  // namespace
