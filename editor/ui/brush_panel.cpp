@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <glm/common.hpp>
 #include <iterator>
 #include <string>
@@ -57,6 +58,16 @@ QString swatchStyle(const glm::dvec3& linear) {
 }
 
 double mean(const glm::dvec3& v) { return (v.x + v.y + v.z) / 3.0; }
+
+// Three significant digits: the panel is read, not copied (the typed prompt keeps six).
+std::string compact(const glm::dvec3& v) {
+  char text[64];
+  if (v.x == v.y && v.y == v.z)
+    std::snprintf(text, sizeof text, "%.3g", v.x);
+  else
+    std::snprintf(text, sizeof text, "%.3g, %.3g, %.3g", v.x, v.y, v.z);
+  return text;
+}
 
 }  // namespace
 
@@ -275,9 +286,10 @@ void BrushPanel::sync() {
   setNumber(g_, b.artist.g);
   colour_->setStyleSheet(swatchStyle(b.artist.colour));
   const std::string units = editor_.session().scene().units;
-  artistView_->setText(QString::fromStdString("colour " + controls.artistFieldText(0) + "\nscatter distance " +
-                                              controls.artistFieldText(1) + " " + units + "\ng " +
-                                              controls.artistFieldText(2)));
+  char g[32];
+  std::snprintf(g, sizeof g, "%.3g", b.artist.g);
+  artistView_->setText(QString::fromStdString("colour " + compact(b.artist.colour) + "\nscatter distance " +
+                                              compact(b.artist.scatterDistance) + " " + units + "\ng " + g));
   const std::string stored = controls.describeStored();
   storedView_->setText(QString::fromStdString(stored.empty() ? "(sigma values: see the status line)" : stored));
   lock_->setChecked(editor_.sliceRangeLocked());
